@@ -1,0 +1,51 @@
+#include "app/deck.hpp"
+
+#include "core/petsc_handle.hpp"
+#include "core/user_error.hpp"
+
+#include <filesystem>
+#include <fstream>
+
+namespace morphogen {
+
+namespace {
+
+// Run a PETSc call with errors returned (not printed as a trace); message on failure.
+template <class F> std::string quietly(F&& f) {
+  MG_PETSC(PetscPushErrorHandler(PetscReturnErrorHandler, nullptr));
+  const PetscErrorCode ierr = f();
+  MG_PETSC(PetscPopErrorHandler());
+  if (!ierr) return {};
+  const char* text = nullptr;
+  PetscErrorMessage(ierr, &text, nullptr);
+  return text ? text : "error";
+}
+
+} // namespace
+
+std::string load_deck(int* argc, char*** argv) {
+  std::string deck, base_dir;
+  if (*argc > 1 && (*argv)[1][0] != '-') deck = (*argv)[1];
+  if (!deck.empty()) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(deck, ec))
+      throw UserError("deck " + deck + ": no such file");
+    std::ifstream probe(deck);
+    if (!probe) throw UserError("deck " + deck + ": cannot be read");
+    const std::string err = quietly([&] {
+      return PetscOptionsInsertFileYAML(PETSC_COMM_WORLD, nullptr, deck.c_str(), PETSC_TRUE);
+    });
+    if (!err.empty()) throw UserError("deck " + deck + ": not a valid YAML deck (" + err + ")");
+    base_dir = std::filesystem::path(deck).parent_path().string();
+  } else {
+    PetscBool f1 = PETSC_FALSE, f2 = PETSC_FALSE;
+    MG_PETSC(PetscOptionsHasName(nullptr, nullptr, "-options_file", &f1));
+    MG_PETSC(PetscOptionsHasName(nullptr, nullptr, "-options_file_yaml", &f2));
+    if (!f1 && !f2) MG_PETSC(PetscOptionsInsertStringYAML(nullptr, kDefaultDeck));
+  }
+  // The command line (and any -options_file) overrides the deck.
+  MG_PETSC(PetscOptionsInsert(nullptr, argc, argv, nullptr));
+  return base_dir;
+}
+
+} // namespace morphogen

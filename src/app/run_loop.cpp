@@ -1,0 +1,78 @@
+#include "app/run_loop.hpp"
+
+#include "core/collective_error.hpp"
+#include "core/user_error.hpp"
+#include "io/png_file.hpp"
+#include "io/slice_gather.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace morphogen {
+
+void write_pngs(Simulation& sim, const std::string& tag) {
+  const Grid& g = sim.grid();
+  const PetscInt k = g.dim() == 3 ? g.spec().n[2] / 2 : 0;
+  int rank = 0;
+  MPI_Comm_rank(g.comm(), &rank);
+  std::string err;
+  for (int s : sim.output().png_species) {
+    const PetscScalar* a;
+    MG_PETSC(VecGetArrayRead(sim.state()[s], &a));
+    std::vector<double> slice = io::gather_xy_slice(g, a, k);
+    MG_PETSC(VecRestoreArrayRead(sim.state()[s], &a));
+    if (rank != 0 || !err.empty()) continue;
+    double lo = sim.output().png_range[s][0], hi = sim.output().png_range[s][1];
+    if (!(lo < hi)) {
+      lo = *std::min_element(slice.begin(), slice.end());
+      hi = *std::max_element(slice.begin(), slice.end());
+    }
+    const std::string path = sim.output().dir + "/" + sim.species()[s] + "_" + tag + ".png";
+    try {
+      io::write_field_png(path, static_cast<int>(g.spec().n[0]), static_cast<int>(g.spec().n[1]),
+                          slice.data(), lo, hi);
+    } catch (const UserError& e) {
+      err = std::string("-output_dir ") + sim.output().dir + ": " + e.what();
+    }
+  }
+  throw_if_any(g.comm(), err);
+}
+
+void run_loop(Simulation& sim) {
+  MPI_Comm comm = sim.grid().comm();
+  const PetscInt steps = sim.steps();
+  const auto& out = sim.output();
+  const double cells = static_cast<double>(sim.grid().global_cells());
+  char tag[32];
+  const double t0 = MPI_Wtime();
+  double t_last = t0;
+  PetscInt step_last = 0;
+  for (PetscInt n = 1; n <= steps; ++n) {
+    sim.step();
+    if (n % out.nan_check_every == 0 || n == steps) sim.check_finite();
+    if (out.png_every > 0 && n % out.png_every == 0 && n != steps) {
+      std::snprintf(tag, sizeof tag, "%07lld", static_cast<long long>(n));
+      write_pngs(sim, tag);
+    }
+    if (n % out.progress_every == 0 || n == steps) {
+      const double now = MPI_Wtime();
+      const double rate = (now - t_last) > 0 ? cells * static_cast<double>(n - step_last) / (now - t_last) : 0;
+      const double elapsed = now - t0;
+      const double eta = elapsed / static_cast<double>(n) * static_cast<double>(steps - n);
+      MG_PETSC(PetscPrintf(comm,
+                           "step %lld/%lld  t %.6g  %5.1f%%  %.3e cell-updates/s  elapsed %.1f s  "
+                           "ETA %.1f s\n",
+                           static_cast<long long>(n), static_cast<long long>(steps), sim.time(),
+                           100.0 * static_cast<double>(n) / static_cast<double>(steps), rate,
+                           elapsed, eta));
+      t_last = now;
+      step_last = n;
+    }
+  }
+  std::snprintf(tag, sizeof tag, "%07lld", static_cast<long long>(steps));
+  write_pngs(sim, tag);
+  write_pngs(sim, "final");
+}
+
+} // namespace morphogen

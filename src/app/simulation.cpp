@@ -1,0 +1,281 @@
+#include "app/simulation.hpp"
+
+#include "core/collective_error.hpp"
+#include "core/user_error.hpp"
+#include "fields/field_fill.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace morphogen {
+
+namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+}
+
+Simulation::Simulation(MPI_Comm comm, Options& opt, const std::string& base_dir) : comm_(comm) {
+  read_grid(opt);
+  read_model(opt, base_dir);
+  read_time(opt);
+  read_output(opt);
+}
+
+void Simulation::read_grid(Options& opt) {
+  const auto n = opt.list("grid_n", {"256", "256"}, 2, 3,
+                          "cells per axis: nx,ny (2-D) or nx,ny,nz (3-D)");
+  spec_.dim = static_cast<int>(n.size());
+  for (int d = 0; d < spec_.dim; ++d) {
+    spec_.n[d] = Options::parse_int("grid_n", n[d]);
+    if (spec_.n[d] < 3 || spec_.n[d] > (1 << 24))
+      throw UserError("-grid_n " + n[d] + ": cells per axis must be in [3, 16777216]");
+  }
+  std::vector<std::string> Ldef;
+  for (int d = 0; d < spec_.dim; ++d) Ldef.push_back(std::to_string(spec_.n[d]));
+  const auto L = opt.list("grid_L", Ldef, 1, 3,
+                          "domain length per axis (one value for all axes); spacing h = L/n");
+  for (int d = 0; d < spec_.dim; ++d) {
+    const std::string& s = L.size() == 1 ? L[0] : L[d];
+    if (L.size() != 1 && static_cast<int>(L.size()) != spec_.dim)
+      throw UserError("-grid_L: expected 1 or " + std::to_string(spec_.dim) + " values, got " +
+                      std::to_string(L.size()));
+    spec_.L[d] = Options::parse_real("grid_L", s);
+    if (!(spec_.L[d] > 0) || !std::isfinite(spec_.L[d]))
+      throw UserError("-grid_L " + s + ": domain length must be > 0");
+  }
+  const auto bc = opt.list("grid_bc", {"periodic"}, 1, 3,
+                           "boundary per axis, one value for all axes or one per axis "
+                           "(periodic, neumann, dirichlet)");
+  if (bc.size() != 1 && static_cast<int>(bc.size()) != spec_.dim)
+    throw UserError("-grid_bc: expected 1 or " + std::to_string(spec_.dim) + " values, got " +
+                    std::to_string(bc.size()));
+  for (int d = 0; d < spec_.dim; ++d) {
+    const std::string& b = bc.size() == 1 ? bc[0] : bc[d];
+    if (b == "periodic") spec_.bc[d] = Boundary::Periodic;
+    else if (b == "neumann" || b == "zero_flux") spec_.bc[d] = Boundary::Neumann;
+    else if (b == "dirichlet") spec_.bc[d] = Boundary::Dirichlet;
+    else throw UserError("-grid_bc " + b + ": unknown boundary, allowed periodic, neumann, dirichlet");
+  }
+  const std::string def_stencil = spec_.dim == 2 ? "5pt" : "7pt";
+  const std::string st =
+      opt.choice("stencil", def_stencil,
+                 spec_.dim == 2 ? std::vector<std::string>{"5pt", "9pt"}
+                                : std::vector<std::string>{"7pt"},
+                 "Laplacian stencil: 5pt or 9pt (isotropic, Garrity) in 2-D, 7pt in 3-D");
+  const double h[3] = {spec_.h(0), spec_.h(1), spec_.h(2)};
+  if (!make_stencil(st, spec_.dim, h, stencil_))
+    throw UserError("-stencil " + st + ": the isotropic 9pt stencil needs equal spacing hx = hy (got " +
+                    format_double(h[0]) + " and " + format_double(h[1]) + ")");
+  spec_.stencil_width = 1;
+  spec_.box_stencil = stencil_.nterms == 9;
+  grid_ = std::make_unique<Grid>(comm_, spec_);
+  spec_ = grid_->spec();
+  halo_ = std::make_unique<Halo>(*grid_);
+}
+
+void Simulation::read_model(Options& opt, const std::string& base_dir) {
+  const std::string name = opt.choice("model", "turing", model_names(), "reaction model");
+  model_ = find_model(name);
+  seed_ = static_cast<std::uint64_t>(
+      opt.integer("seed", 1, 0, std::numeric_limits<PetscInt>::max(),
+                  "seed of every random value (hashed with the key and the global cell index)"));
+  const bool clamp = opt.flag("clamp", model_->clamp_default,
+                              "clamp negative concentrations to 0 after each step");
+  const int ns = model_->nspecies, np = model_->nparams;
+
+  // Parameters: scalars where constant, fields where they vary.
+  params_.names.clear();
+  for (int q = 0; q < np; ++q) {
+    const ParamInfo& p = model_->params[q];
+    const std::string key = std::string("params_") + p.name;
+    const std::string help = std::string(p.doc) + " [" + format_double(p.lo) + ", " +
+                             format_double(p.hi) + "]; a number, expression, 'v +- a%' or png(...)";
+    const std::string text = opt.string(key, format_double(p.def), help);
+    ValueSpec vs(key, text, spec_, seed_, base_dir);
+    params_.names.emplace_back(p.name);
+    if (vs.uses_time())
+      throw UserError("-" + key + " " + text +
+                      ": time-dependent parameters (t) are not supported by the explicit integrator yet");
+    if (vs.is_constant()) {
+      const double v = vs.constant_value();
+      if (!(v >= p.lo && v <= p.hi))
+        throw UserError("-" + key + " " + text + ": out of range, allowed [" + format_double(p.lo) +
+                        ", " + format_double(p.hi) + "]");
+      params_.scalar.push_back(v);
+      params_.field.emplace_back();
+    } else {
+      VecH f = grid_->create_global();
+      PetscScalar* a;
+      MG_PETSC(VecGetArray(f, &a));
+      try {
+        fill_field(*grid_, vs, a, ArrayLayout::Owned, p.lo, p.hi);
+      } catch (...) {
+        MG_PETSC(VecRestoreArray(f, &a));
+        throw;
+      }
+      MG_PETSC(VecRestoreArray(f, &a));
+      params_.scalar.push_back(std::nan(""));
+      params_.field.push_back(std::move(f));
+    }
+  }
+
+  // Species: diffusion, initial values, Dirichlet values.
+  species_.clear();
+  D_.assign(ns, 0.0);
+  floor_.assign(ns, clamp ? 0.0 : -kInf);
+  bool any_dirichlet = false;
+  for (int d = 0; d < spec_.dim; ++d) any_dirichlet |= spec_.bc[d] == Boundary::Dirichlet;
+  dirichlet_.assign(any_dirichlet ? ns : 0, FaceValues{});
+  u_.clear();
+  work_.clear();
+  for (int s = 0; s < ns; ++s) {
+    const SpeciesInfo& si = model_->species[s];
+    species_.emplace_back(si.name);
+    D_[s] = opt.real(std::string("D_") + si.name, si.D, 0.0, kInf,
+                     std::string("diffusion coefficient of ") + si.name + " (" + si.doc + ")");
+    const std::string ikey = std::string("init_") + si.name;
+    ValueSpec init(ikey,
+                   opt.string(ikey, format_double(si.init),
+                              std::string("initial value of ") + si.name +
+                                  ": number, expression, 'v +- a%', shapes, png(...)"),
+                   spec_, seed_, base_dir);
+    u_.push_back(grid_->create_local());
+    work_.push_back(grid_->create_local());
+    PetscScalar* a;
+    MG_PETSC(VecGetArray(u_.back(), &a));
+    try {
+      fill_field(*grid_, init, a, ArrayLayout::Ghosted, -kInf, kInf);
+    } catch (...) {
+      MG_PETSC(VecRestoreArray(u_.back(), &a));
+      throw;
+    }
+    MG_PETSC(VecRestoreArray(u_.back(), &a));
+    if (any_dirichlet) {
+      const std::string dkey = std::string("dirichlet_") + si.name;
+      ValueSpec g(dkey,
+                  opt.string(dkey, format_double(si.init),
+                             std::string("Dirichlet boundary value of ") + si.name +
+                                 " (expression of the face position)"),
+                  spec_, seed_, base_dir);
+      const Box& gb = grid_->ghosted();
+      for (int d = 0; d < spec_.dim; ++d) {
+        if (spec_.bc[d] != Boundary::Dirichlet) continue;
+        for (int side = 0; side < 2; ++side) {
+          auto& face = dirichlet_[s].face[2 * d + side];
+          face.assign(static_cast<size_t>(halo_->face_size(d)), 0.0);
+          std::string err;
+          try {
+            for (PetscInt k = gb.s[2]; k < gb.s[2] + gb.m[2]; ++k)
+              for (PetscInt j = gb.s[1]; j < gb.s[1] + gb.m[1]; ++j)
+                for (PetscInt i = gb.s[0]; i < gb.s[0] + gb.m[0]; ++i) {
+                  PetscInt c[3] = {i, j, k};
+                  if (c[d] != gb.s[d]) continue; // one entry per face position
+                  double x[3] = {grid_->centre(0, i), grid_->centre(1, j),
+                                 spec_.dim == 3 ? grid_->centre(2, k) : 0.0};
+                  x[d] = side == 0 ? 0.0 : spec_.L[d];
+                  c[d] = side == 0 ? 0 : spec_.n[d] - 1;
+                  face[halo_->face_index(d, i, j, k)] = g.at_point(x[0], x[1], x[2], c[0], c[1], c[2]);
+                }
+          } catch (const UserError& e) {
+            err = e.what();
+          }
+          throw_if_any(comm_, err);
+        }
+      }
+    }
+  }
+  const ExplicitIntegrator::RowFn fn = model_->row_kernel(params_.any_field(), stencil_.nterms);
+  integrator_ = std::make_unique<ExplicitIntegrator>(*grid_, *halo_, fn, ns, stencil_, D_, floor_,
+                                                     params_, any_dirichlet ? &dirichlet_ : nullptr);
+  integrator_->update_ghosts(u_);
+}
+
+void Simulation::read_time(Options& opt) {
+  opt.choice("integrator", "explicit", {"explicit"},
+             "time integrator: explicit (forward Euler, diffusion and reaction fused)");
+  stable_dt_ = ExplicitIntegrator::stable_dt(stencil_, D_);
+  const double def_dt = std::isfinite(stable_dt_) ? 0.9 * stable_dt_ : 1.0;
+  dt_ = opt.real("dt", def_dt, 0.0, kInf, "time step");
+  if (!(dt_ > 0)) throw UserError("-dt " + format_double(dt_) + ": must be > 0");
+  const bool force = opt.flag("force_dt", false,
+                              "run even when -dt exceeds the explicit diffusion stability bound");
+  if (dt_ > stable_dt_ && !force)
+    throw UserError("-dt " + format_double(dt_) +
+                    ": exceeds the explicit diffusion stability bound dt <= " +
+                    format_double(stable_dt_) + " (2/(D_max*rho(L)) for the " + stencil_.name +
+                    " stencil, D_max = " +
+                    format_double(*std::max_element(D_.begin(), D_.end())) +
+                    "); use a smaller -dt or -force_dt");
+  steps_ = opt.integer("steps", 1000, 0, std::numeric_limits<PetscInt>::max(),
+                       "number of time steps");
+}
+
+void Simulation::read_output(Options& opt) {
+  out_.dir = opt.string("output_dir", "morphogen_out", "directory for images and options_used.yaml");
+  if (out_.dir.empty()) throw UserError("-output_dir: must not be empty");
+  out_.png_every = opt.integer("png_every", 0, 0, std::numeric_limits<PetscInt>::max(),
+                               "write PNG images every N steps (0: only at the end)");
+  const auto names = opt.list("png_species", species_, 0, 16,
+                              "species written as PNG images (default: all)");
+  out_.png_species.clear();
+  for (const auto& n : names) {
+    auto it = std::find(species_.begin(), species_.end(), n);
+    if (it == species_.end()) {
+      std::string all;
+      for (auto& s : species_) all += (all.empty() ? "" : ", ") + s;
+      throw UserError("-png_species " + n + ": no such species in model " + model_->name +
+                      ", allowed " + all);
+    }
+    out_.png_species.push_back(static_cast<int>(it - species_.begin()));
+  }
+  out_.png_range.assign(species_.size(), {1.0, 0.0});
+  for (size_t s = 0; s < species_.size(); ++s) {
+    const std::string key = "png_range_" + species_[s];
+    if (!opt.is_set(key)) {
+      opt.known(key);
+      continue;
+    }
+    const auto r = opt.list(key, {}, 2, 2, "colour range lo,hi of " + species_[s] + " images");
+    out_.png_range[s] = {Options::parse_real(key, r[0]), Options::parse_real(key, r[1])};
+    if (!(out_.png_range[s][0] < out_.png_range[s][1]))
+      throw UserError("-" + key + " " + r[0] + "," + r[1] + ": needs lo < hi");
+  }
+  out_.progress_every =
+      opt.integer("progress_every", std::max<PetscInt>(1, steps_ / 20), 1,
+                  std::numeric_limits<PetscInt>::max(), "print a progress line every N steps");
+  out_.nan_check_every =
+      opt.integer("nan_check_every", 100, 1, std::numeric_limits<PetscInt>::max(),
+                  "check for NaN/Inf every N steps (stops the run with the cell and time)");
+}
+
+void Simulation::step() {
+  integrator_->step(u_, work_, dt_);
+  t_ += dt_;
+  ++step_;
+}
+
+void Simulation::check_finite() const {
+  std::string err;
+  const Box& ob = grid_->owned();
+  for (size_t s = 0; s < u_.size() && err.empty(); ++s) {
+    const PetscScalar* a;
+    MG_PETSC(VecGetArrayRead(u_[s], &a));
+    for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2] && err.empty(); ++k)
+      for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1] && err.empty(); ++j)
+        for (PetscInt i = ob.s[0]; i < ob.s[0] + ob.m[0]; ++i) {
+          const double v = a[grid_->local_index(i, j, k)];
+          if (!std::isfinite(v)) {
+            err = "species " + species_[s] + " became " + format_double(v) + " at cell (" +
+                  std::to_string(i) + "," + std::to_string(j) + "," + std::to_string(k) +
+                  ") by step " + std::to_string(step_) + " (t = " + format_double(t_) +
+                  "): the run diverged; reduce -dt" +
+                  (floor_[s] == 0.0 ? std::string() : std::string(" or try -clamp true"));
+            break;
+          }
+        }
+    MG_PETSC(VecRestoreArrayRead(u_[s], &a));
+  }
+  throw_if_any(comm_, err);
+}
+
+} // namespace morphogen

@@ -1,0 +1,77 @@
+// A configured run: grid, model, fields, integrator and output settings, all read from the
+// options database (decks are loaded into it first). Construction validates everything and
+// throws UserError before any output is written.
+#pragma once
+
+#include "app/model_registry.hpp"
+#include "core/options.hpp"
+#include "fields/param_set.hpp"
+#include "grid/halo.hpp"
+#include "integrators/explicit_integrator.hpp"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace morphogen {
+
+struct OutputSettings {
+  std::string dir;
+  PetscInt png_every = 0; // 0: only the final image
+  std::vector<int> png_species;
+  std::vector<std::array<double, 2>> png_range; // lo > hi means automatic (min/max per image)
+  PetscInt progress_every = 0;
+  PetscInt nan_check_every = 100;
+};
+
+class Simulation {
+public:
+  // base_dir: where relative file names in values (png("...")) are looked up first.
+  Simulation(MPI_Comm comm, Options& opt, const std::string& base_dir);
+
+  const ModelEntry& model() const { return *model_; }
+  const Grid& grid() const { return *grid_; }
+  const std::vector<std::string>& species() const { return species_; }
+  const std::vector<double>& diffusion() const { return D_; }
+  std::vector<VecH>& state() { return u_; }
+  const OutputSettings& output() const { return out_; }
+  double dt() const { return dt_; }
+  double stable_dt() const { return stable_dt_; }
+  PetscInt steps() const { return steps_; }
+  double time() const { return t_; }
+  PetscInt step_index() const { return step_; }
+  const Stencil& stencil() const { return stencil_; }
+  std::uint64_t seed() const { return seed_; }
+
+  // Advance one explicit step.
+  void step();
+  // Make ghosts current (after initialisation or before reading neighbours).
+  void refresh_ghosts() { integrator_->update_ghosts(u_); }
+  // Collective: throws UserError naming species, cell, step and time if any value is NaN/Inf.
+  void check_finite() const;
+
+private:
+  void read_grid(Options& opt);
+  void read_model(Options& opt, const std::string& base_dir);
+  void read_time(Options& opt);
+  void read_output(Options& opt);
+
+  MPI_Comm comm_;
+  const ModelEntry* model_ = nullptr;
+  GridSpec spec_;
+  std::unique_ptr<Grid> grid_;
+  std::unique_ptr<Halo> halo_;
+  Stencil stencil_;
+  std::vector<std::string> species_;
+  std::vector<double> D_, floor_;
+  ParamSet params_;
+  std::vector<FaceValues> dirichlet_;
+  std::vector<VecH> u_, work_;
+  std::unique_ptr<ExplicitIntegrator> integrator_;
+  std::uint64_t seed_ = 1;
+  double dt_ = 0, stable_dt_ = 0, t_ = 0;
+  PetscInt steps_ = 0, step_ = 0;
+  OutputSettings out_;
+};
+
+} // namespace morphogen

@@ -1,0 +1,230 @@
+#include "core/options.hpp"
+
+#include "core/petsc_handle.hpp"
+#include "core/user_error.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+
+namespace morphogen {
+
+std::string format_double(double v) {
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  // Prefer the shortest representation that round-trips.
+  for (int prec = 1; prec <= 17; ++prec) {
+    char b2[64];
+    std::snprintf(b2, sizeof b2, "%.*g", prec, v);
+    if (std::strtod(b2, nullptr) == v) return b2;
+  }
+  return buf;
+}
+
+size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<size_t> prev(b.size() + 1), cur(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) prev[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    cur[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t sub = prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1);
+      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, sub});
+    }
+    std::swap(prev, cur);
+  }
+  return prev[b.size()];
+}
+
+Options::Options(MPI_Comm comm) : comm_(comm) {
+  PetscBool h = PETSC_FALSE;
+  MG_PETSC(PetscOptionsHasName(nullptr, nullptr, "-help", &h));
+  help_ = h;
+}
+
+void Options::record(const std::string& name, const std::string& value, const std::string& help) {
+  for (auto& r : records_)
+    if (r.name == name) {
+      r.value = value;
+      return;
+    }
+  records_.push_back({name, value, help});
+  if (help_)
+    MG_PETSC(PetscPrintf(comm_, "  -%s <%s>: %s\n", name.c_str(), value.c_str(), help.c_str()));
+}
+
+std::optional<std::string> Options::get(const std::string& name, const std::string& help) {
+  char buf[4096];
+  PetscBool set = PETSC_FALSE;
+  const std::string key = "-" + name;
+  MG_PETSC(PetscOptionsGetString(nullptr, nullptr, key.c_str(), buf, sizeof buf, &set));
+  if (!set) {
+    known_.push_back(name);
+    if (help_) MG_PETSC(PetscPrintf(comm_, "  -%s <unset>: %s\n", name.c_str(), help.c_str()));
+    return std::nullopt;
+  }
+  record(name, buf, help);
+  return std::string(buf);
+}
+
+bool Options::is_set(const std::string& name) const {
+  PetscBool set = PETSC_FALSE;
+  MG_PETSC(PetscOptionsHasName(nullptr, nullptr, ("-" + name).c_str(), &set));
+  return set;
+}
+
+double Options::parse_real(const std::string& name, const std::string& text) {
+  errno = 0;
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  while (end && *end == ' ') ++end;
+  if (text.empty() || !end || *end != '\0' || errno == ERANGE || std::isnan(v))
+    throw UserError("-" + name + " " + text + ": not a number");
+  return v;
+}
+
+PetscInt Options::parse_int(const std::string& name, const std::string& text) {
+  errno = 0;
+  char* end = nullptr;
+  const long long v = std::strtoll(text.c_str(), &end, 10);
+  while (end && *end == ' ') ++end;
+  if (text.empty() || !end || *end != '\0' || errno == ERANGE)
+    throw UserError("-" + name + " " + text + ": not an integer");
+  return static_cast<PetscInt>(v);
+}
+
+double Options::real(const std::string& name, double def, double lo, double hi,
+                     const std::string& help) {
+  const std::string h = help + " [" + format_double(lo) + ", " + format_double(hi) + "]";
+  auto s = get(name, h);
+  const double v = s ? parse_real(name, *s) : def;
+  if (!(v >= lo && v <= hi))
+    throw UserError("-" + name + " " + (s ? *s : format_double(v)) + ": out of range, allowed [" +
+                    format_double(lo) + ", " + format_double(hi) + "]");
+  record(name, format_double(v), h);
+  return v;
+}
+
+PetscInt Options::integer(const std::string& name, PetscInt def, PetscInt lo, PetscInt hi,
+                          const std::string& help) {
+  const std::string h = help + " [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  auto s = get(name, h);
+  const PetscInt v = s ? parse_int(name, *s) : def;
+  if (v < lo || v > hi)
+    throw UserError("-" + name + " " + (s ? *s : std::to_string(v)) +
+                    ": out of range, allowed [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                    "]");
+  record(name, std::to_string(v), h);
+  return v;
+}
+
+bool Options::flag(const std::string& name, bool def, const std::string& help) {
+  const std::string h = help + " (true/false)";
+  auto s = get(name, h);
+  bool v = def;
+  if (s) {
+    std::string t = *s;
+    std::transform(t.begin(), t.end(), t.begin(), ::tolower);
+    if (t.empty() || t == "true" || t == "1" || t == "yes" || t == "on") v = true;
+    else if (t == "false" || t == "0" || t == "no" || t == "off") v = false;
+    else throw UserError("-" + name + " " + *s + ": not a boolean, allowed true or false");
+  }
+  record(name, v ? "true" : "false", h);
+  return v;
+}
+
+std::string Options::string(const std::string& name, const std::string& def,
+                            const std::string& help) {
+  auto s = get(name, help);
+  const std::string v = s ? *s : def;
+  record(name, v, help);
+  return v;
+}
+
+std::string Options::choice(const std::string& name, const std::string& def,
+                            const std::vector<std::string>& allowed, const std::string& help) {
+  std::string all;
+  for (auto& a : allowed) all += (all.empty() ? "" : ", ") + a;
+  const std::string h = help + " (" + all + ")";
+  auto s = get(name, h);
+  const std::string v = s ? *s : def;
+  if (std::find(allowed.begin(), allowed.end(), v) == allowed.end()) {
+    std::string best;
+    size_t bd = 4;
+    for (auto& a : allowed)
+      if (size_t d = edit_distance(v, a); d < bd) bd = d, best = a;
+    throw UserError("-" + name + " " + v + ": unknown, allowed " + all +
+                    (best.empty() ? "" : " (did you mean " + best + "?)"));
+  }
+  record(name, v, h);
+  return v;
+}
+
+std::vector<std::string> Options::list(const std::string& name,
+                                       const std::vector<std::string>& def, size_t min_count,
+                                       size_t max_count, const std::string& help) {
+  auto s = get(name, help);
+  std::vector<std::string> v;
+  if (s) {
+    std::stringstream ss(*s);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+      const auto b = item.find_first_not_of(" \t"), e = item.find_last_not_of(" \t");
+      v.push_back(b == std::string::npos ? "" : item.substr(b, e - b + 1));
+    }
+  } else {
+    v = def;
+  }
+  if (v.size() < min_count || v.size() > max_count)
+    throw UserError("-" + name + " " + (s ? *s : "") + ": expected " +
+                    (min_count == max_count ? std::to_string(min_count)
+                                            : std::to_string(min_count) + " to " +
+                                                  std::to_string(max_count)) +
+                    " comma-separated values, got " + std::to_string(v.size()));
+  std::string joined;
+  for (auto& x : v) joined += (joined.empty() ? "" : ",") + x;
+  record(name, joined, help);
+  return v;
+}
+
+void Options::check_unused() const {
+  PetscInt n = 0;
+  char** names = nullptr;
+  char** values = nullptr;
+  MG_PETSC(PetscOptionsLeftGet(nullptr, &n, &names, &values));
+  std::string msg;
+  for (PetscInt i = 0; i < n && msg.empty(); ++i) {
+    const std::string name = names[i];
+    if (name == "help" || name == "h") continue;
+    std::string best;
+    size_t bd = std::max<size_t>(3, name.size() / 3) + 1;
+    auto consider = [&](const std::string& cand) {
+      if (size_t d = edit_distance(name, cand); d < bd) bd = d, best = cand;
+    };
+    for (auto& r : records_) consider(r.name);
+    for (auto& k : known_) consider(k);
+    msg = "-" + name + (values[i] ? " " + std::string(values[i]) : std::string()) +
+          ": unknown option (nothing read it)" +
+          (best.empty() ? "; see -help" : "; did you mean -" + best + "?");
+  }
+  MG_PETSC(PetscOptionsLeftRestore(nullptr, &n, &names, &values));
+  if (!msg.empty()) throw UserError(msg);
+}
+
+std::string Options::to_yaml(const std::string& header) const {
+  std::string out = header;
+  for (auto& r : records_) {
+    std::string v;
+    for (char c : r.value) {
+      if (c == '"' || c == '\\') v += '\\';
+      v += c;
+    }
+    out += r.name + ": \"" + v + "\"\n";
+  }
+  return out;
+}
+
+} // namespace morphogen

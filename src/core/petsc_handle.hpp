@@ -1,0 +1,67 @@
+// RAII owners for PETSc objects (Vec, DM, ...): destroy on scope exit, so an exception
+// (UserError) unwinding through morphogen's own code leaks nothing. Destroy errors are ignored
+// (a destructor cannot report them; PETSc prints its own trace).
+#pragma once
+
+#include <petscdm.h>
+#include <petscsf.h>
+#include <petscvec.h>
+#include <utility>
+
+namespace morphogen {
+
+template <class T, PetscErrorCode (*Destroy)(T*)> class PetscHandle {
+public:
+  PetscHandle() = default;
+  explicit PetscHandle(T obj) : obj_(obj) {}
+  PetscHandle(const PetscHandle&) = delete;
+  PetscHandle& operator=(const PetscHandle&) = delete;
+  PetscHandle(PetscHandle&& o) noexcept : obj_(std::exchange(o.obj_, nullptr)) {}
+  PetscHandle& operator=(PetscHandle&& o) noexcept {
+    if (this != &o) {
+      reset();
+      obj_ = std::exchange(o.obj_, nullptr);
+    }
+    return *this;
+  }
+  ~PetscHandle() { reset(); }
+  void reset() {
+    if (obj_) (void)Destroy(&obj_);
+    obj_ = nullptr;
+  }
+  T get() const { return obj_; }
+  T* out() {
+    reset();
+    return &obj_;
+  }
+  operator T() const { return obj_; }
+
+private:
+  T obj_ = nullptr;
+};
+
+using VecH = PetscHandle<Vec, VecDestroy>;
+using DMH = PetscHandle<DM, DMDestroy>;
+using SFH = PetscHandle<PetscSF, PetscSFDestroy>;
+
+// Throwing wrapper for PETSc calls made from code that cannot return PetscErrorCode
+// (constructors, destructors' callers). PETSc has already printed its trace when this fires.
+struct PetscFailure : std::exception {
+  PetscErrorCode code;
+  explicit PetscFailure(PetscErrorCode c) : code(c) {}
+  const char* what() const noexcept override { return "PETSc error (trace above)"; }
+};
+
+} // namespace morphogen
+
+// PetscCall for functions that do not return PetscErrorCode: PETSc prints its trace, then we
+// throw so main() can finalise cleanly and exit non-zero.
+#define MG_PETSC(...)                                                                              \
+  do {                                                                                             \
+    PetscErrorCode mg_ierr_ = (__VA_ARGS__);                                                       \
+    if (PetscUnlikely(mg_ierr_)) {                                                                 \
+      (void)PetscError(PETSC_COMM_SELF, __LINE__, PETSC_FUNCTION_NAME, __FILE__, mg_ierr_,         \
+                       PETSC_ERROR_REPEAT, " ");                                                   \
+      throw ::morphogen::PetscFailure(mg_ierr_);                                                   \
+    }                                                                                              \
+  } while (0)

@@ -1,0 +1,34 @@
+#include "fields/field_fill.hpp"
+
+#include "core/collective_error.hpp"
+#include "core/options.hpp"
+#include "core/user_error.hpp"
+
+namespace morphogen {
+
+void fill_field(const Grid& grid, ValueSpec& spec, double* a, ArrayLayout layout, double lo,
+                double hi, double t) {
+  std::string err;
+  try {
+    const Box& ob = grid.owned();
+    for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2] && err.empty(); ++k)
+      for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1] && err.empty(); ++j)
+        for (PetscInt i = ob.s[0]; i < ob.s[0] + ob.m[0]; ++i) {
+          const double v = spec.at_cell(i, j, k, t);
+          if (!(v >= lo && v <= hi)) {
+            err = "-" + spec.key() + " " + spec.text() + ": value " + format_double(v) +
+                  " at cell (" + std::to_string(i) + "," + std::to_string(j) + "," +
+                  std::to_string(k) + ") is outside the allowed range [" + format_double(lo) +
+                  ", " + format_double(hi) + "]";
+            break;
+          }
+          a[layout == ArrayLayout::Owned ? grid.owned_index(i, j, k) : grid.local_index(i, j, k)] =
+              v;
+        }
+  } catch (const UserError& e) {
+    err = e.what();
+  }
+  throw_if_any(grid.comm(), err);
+}
+
+} // namespace morphogen

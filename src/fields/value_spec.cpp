@@ -1,0 +1,230 @@
+#include "fields/value_spec.hpp"
+
+#include "core/hash_rng.hpp"
+#include "core/options.hpp"
+#include "core/user_error.hpp"
+
+#include <cmath>
+#include <muParser.h>
+#include <regex>
+
+namespace morphogen {
+
+namespace {
+
+std::string trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t"), e = s.find_last_not_of(" \t");
+  return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
+}
+
+// Position of a top-level "+-" (outside parentheses and quotes), or npos.
+size_t find_plus_minus(const std::string& s) {
+  int depth = 0;
+  bool quoted = false;
+  for (size_t p = 0; p + 1 < s.size(); ++p) {
+    const char c = s[p];
+    if (c == '"') quoted = !quoted;
+    if (quoted) continue;
+    if (c == '(') ++depth;
+    if (c == ')') --depth;
+    if (depth == 0 && c == '+' && s[p + 1] == '-') return p;
+  }
+  return std::string::npos;
+}
+
+double periodic_delta(double d, double L, bool periodic) {
+  if (!periodic) return d;
+  d = std::fmod(d, L);
+  if (d > 0.5 * L) d -= L;
+  if (d < -0.5 * L) d += L;
+  return d;
+}
+
+} // namespace
+
+// muParser callbacks (user data = the ValueSpec being evaluated).
+struct ValueSpecFunctions {
+  static ValueSpec& vs(void* p) { return *static_cast<ValueSpec*>(p); }
+  static double dx(ValueSpec& v, int d, double c) {
+    const double pos = d == 0 ? v.x_ : d == 1 ? v.y_ : v.z_;
+    return periodic_delta(pos - c, v.grid_.L[d], v.grid_.bc[d] == Boundary::Periodic);
+  }
+  static double square(void* p, double cx, double cy, double half) {
+    auto& v = vs(p);
+    return std::abs(dx(v, 0, cx)) <= half && std::abs(dx(v, 1, cy)) <= half ? 1.0 : 0.0;
+  }
+  static double disk(void* p, double cx, double cy, double radius) {
+    auto& v = vs(p);
+    const double a = dx(v, 0, cx), b = dx(v, 1, cy);
+    return a * a + b * b <= radius * radius ? 1.0 : 0.0;
+  }
+  static double ball(void* p, double cx, double cy, double cz, double radius) {
+    auto& v = vs(p);
+    const double a = dx(v, 0, cx), b = dx(v, 1, cy), c = dx(v, 2, cz);
+    return a * a + b * b + c * c <= radius * radius ? 1.0 : 0.0;
+  }
+  static double spots(void* p, double n, double radius, double seed) {
+    auto& v = vs(p);
+    const auto s = static_cast<std::uint64_t>(std::llround(seed));
+    const std::uint64_t stream = rng::stream_id("spots");
+    const long count = std::lround(n);
+    for (long m = 0; m < count; ++m) {
+      double d2 = 0;
+      for (int d = 0; d < v.grid_.dim; ++d) {
+        const double c = rng::uniform(s, stream, static_cast<std::uint64_t>(3 * m + d)) * v.grid_.L[d];
+        const double e = dx(v, d, c);
+        d2 += e * e;
+      }
+      if (d2 <= radius * radius) return 1.0;
+    }
+    return 0.0;
+  }
+  static double noise(void* p) {
+    auto& v = vs(p);
+    return rng::uniform(v.seed_, v.stream_ ^ 0x6e6f697365ULL, v.cell_);
+  }
+  static double gnoise(void* p) {
+    auto& v = vs(p);
+    return rng::gaussian(v.seed_, v.stream_ ^ 0x676e6f697365ULL, v.cell_);
+  }
+  static double png(void* p, const char* file, double lo, double hi) {
+    auto& v = vs(p);
+    const auto it = v.images_.find(file);
+    if (it == v.images_.end()) return std::nan("");
+    const double u = v.x_ / v.grid_.L[0], w = v.y_ / v.grid_.L[1];
+    return lo + (hi - lo) * io::sample_bilinear(it->second, u, w);
+  }
+};
+
+ValueSpec::ValueSpec(const std::string& key, const std::string& text, const GridSpec& grid,
+                     std::uint64_t seed, const std::string& base_dir)
+    : key_(key), text_(text), base_dir_(base_dir), grid_(grid), seed_(seed),
+      stream_(rng::stream_id(key)), parser_(std::make_unique<mu::Parser>()) {
+  std::string expr = text;
+  if (const size_t pm = find_plus_minus(text); pm != std::string::npos) {
+    expr = text.substr(0, pm);
+    static const std::regex amount_re(R"(^\s*([0-9.eE+\-]+)\s*(%?)\s*(uniform|gauss|gaussian)?\s*$)");
+    std::smatch m;
+    const std::string rest = text.substr(pm + 2);
+    if (!std::regex_match(rest, m, amount_re))
+      throw UserError("-" + key + " " + text +
+                      ": bad perturbation after '+-', expected AMOUNT[%] [uniform|gauss]");
+    amount_ = Options::parse_real(key, m[1].str());
+    if (amount_ < 0) throw UserError("-" + key + " " + text + ": perturbation amount must be >= 0");
+    percent_ = !m[2].str().empty();
+    perturb_ = m[3].matched && m[3].str() != "uniform" ? Perturb::Gauss : Perturb::Uniform;
+  }
+  expr = trim(expr);
+  if (expr.empty()) throw UserError("-" + key + ": empty value");
+
+  // Images named in png("...") are loaded once, up front, so a missing file fails at setup.
+  static const std::regex png_re(R"(png\s*\(\s*"([^"]*)\")");
+  for (std::sregex_iterator it(expr.begin(), expr.end(), png_re), end; it != end; ++it) {
+    const std::string file = (*it)[1].str();
+    std::string path = file;
+    if (!base_dir_.empty() && !file.empty() && file[0] != '/') {
+      const std::string alt = base_dir_ + "/" + file;
+      if (FILE* f = std::fopen(alt.c_str(), "rb")) {
+        std::fclose(f);
+        path = alt;
+      }
+    }
+    try {
+      images_.emplace(file, io::read_png_grey(path));
+    } catch (const UserError& e) {
+      throw UserError("-" + key + " " + text + ": " + e.what());
+    }
+  }
+
+  mu::Parser& P = *parser_;
+  try {
+    P.DefineVar("x", &x_);
+    P.DefineVar("y", &y_);
+    P.DefineVar("z", &z_);
+    P.DefineVar("i", &i_);
+    P.DefineVar("j", &j_);
+    P.DefineVar("k", &k_);
+    P.DefineVar("r", &r_);
+    P.DefineVar("theta", &theta_);
+    P.DefineVar("t", &t_);
+    const char* L[3] = {"Lx", "Ly", "Lz"};
+    const char* N[3] = {"nx", "ny", "nz"};
+    const char* H[3] = {"hx", "hy", "hz"};
+    for (int d = 0; d < 3; ++d) {
+      P.DefineConst(L[d], grid.L[d]);
+      P.DefineConst(N[d], static_cast<double>(grid.n[d]));
+      P.DefineConst(H[d], grid.h(d));
+    }
+    P.DefineConst("pi", M_PI);
+    P.DefineFunUserData("square", &ValueSpecFunctions::square, this, false);
+    P.DefineFunUserData("disk", &ValueSpecFunctions::disk, this, false);
+    P.DefineFunUserData("ball", &ValueSpecFunctions::ball, this, false);
+    P.DefineFunUserData("spots", &ValueSpecFunctions::spots, this, false);
+    P.DefineFunUserData("noise", &ValueSpecFunctions::noise, this, false);
+    P.DefineFunUserData("gnoise", &ValueSpecFunctions::gnoise, this, false);
+    P.DefineFunUserData("png", &ValueSpecFunctions::png, this, false);
+    P.SetExpr(expr);
+    const auto& used = P.GetUsedVar(); // parses; throws on syntax errors
+    uses_t_ = used.count("t") > 0;
+    static const std::regex cellwise(R"(\b(square|disk|ball|spots|noise|gnoise|png)\s*\()");
+    const bool cell_funcs = std::regex_search(expr, cellwise);
+    if (used.empty() && !cell_funcs && perturb_ == Perturb::None) {
+      constant_ = true;
+      value_ = P.Eval();
+      if (!std::isfinite(value_))
+        throw UserError("-" + key + " " + text + ": evaluates to " + format_double(value_));
+    }
+  } catch (const mu::Parser::exception_type& e) {
+    throw UserError("-" + key + " " + text + ": " + e.GetMsg());
+  }
+}
+
+ValueSpec::~ValueSpec() = default;
+
+std::string ValueSpec::where() const {
+  return " at cell (" + std::to_string(static_cast<long>(i_)) + "," +
+         std::to_string(static_cast<long>(j_)) + "," + std::to_string(static_cast<long>(k_)) + ")";
+}
+
+double ValueSpec::eval_expr() {
+  double v;
+  try {
+    v = parser_->Eval();
+  } catch (const mu::Parser::exception_type& e) {
+    throw UserError("-" + key_ + " " + text_ + ": " + e.GetMsg() + where());
+  }
+  if (perturb_ != Perturb::None) {
+    const double a = percent_ ? amount_ * 0.01 * std::abs(v) : amount_;
+    v += perturb_ == Perturb::Uniform
+             ? a * (2.0 * rng::uniform(seed_, stream_, cell_) - 1.0)
+             : a * rng::gaussian(seed_, stream_, cell_);
+  }
+  if (!std::isfinite(v))
+    throw UserError("-" + key_ + " " + text_ + ": evaluates to " + format_double(v) + where());
+  return v;
+}
+
+double ValueSpec::at_point(double x, double y, double z, PetscInt i, PetscInt j, PetscInt k,
+                           double t) {
+  if (constant_) return value_;
+  x_ = x, y_ = y, z_ = z, t_ = t;
+  i_ = static_cast<double>(i), j_ = static_cast<double>(j), k_ = static_cast<double>(k);
+  const double cx = x - 0.5 * grid_.L[0], cy = y - 0.5 * grid_.L[1];
+  r_ = std::sqrt(cx * cx + cy * cy);
+  theta_ = std::atan2(cy, cx);
+  const auto wrap = [&](PetscInt c, int d) { return ((c % grid_.n[d]) + grid_.n[d]) % grid_.n[d]; };
+  cell_ = static_cast<std::uint64_t>(wrap(i, 0)) +
+          static_cast<std::uint64_t>(grid_.n[0]) *
+              (static_cast<std::uint64_t>(wrap(j, 1)) +
+               static_cast<std::uint64_t>(grid_.n[1]) * static_cast<std::uint64_t>(wrap(k, 2)));
+  return eval_expr();
+}
+
+double ValueSpec::at_cell(PetscInt i, PetscInt j, PetscInt k, double t) {
+  const double x = (static_cast<double>(i) + 0.5) * grid_.h(0);
+  const double y = (static_cast<double>(j) + 0.5) * grid_.h(1);
+  const double z = grid_.dim == 3 ? (static_cast<double>(k) + 0.5) * grid_.h(2) : 0.0;
+  return at_point(x, y, z, i, j, k, t);
+}
+
+} // namespace morphogen

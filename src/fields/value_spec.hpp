@@ -1,0 +1,78 @@
+// A value given in a deck or on the command line, evaluated at every cell into a field.
+//
+// Grammar:  VALUE := EXPR [ "+-" AMOUNT ["%"] [uniform | gauss] ]
+//   EXPR    a muParser expression. Variables: x y z (cell-centre coordinates), i j k (global
+//           cell indices), r and theta (polar radius and angle about the domain centre, in the
+//           x-y plane), Lx Ly Lz (domain lengths), nx ny nz (cells), hx hy hz (spacings), t (time,
+//           0 at the start). Functions beyond muParser's own:
+//             square(cx, cy, half)   1 inside the axis-aligned square of half-width `half`, else 0
+//             disk(cx, cy, radius)   1 inside the disk (x-y distance), else 0
+//             ball(cx, cy, cz, radius)  1 inside the sphere, else 0
+//             spots(n, radius, seed) 1 inside any of n disks (balls in 3-D) whose centres are
+//                                    hashed from seed (periodic axes use the minimum image)
+//             noise()                uniform deviate in [0,1) of this cell
+//             gnoise()               standard normal deviate of this cell
+//             png("file.png", lo, hi)  grey level of an image stretched over the domain
+//                                    (black = lo, white = hi, bilinear)
+//   "+-"    perturbation per cell: uniform in [v - a, v + a] (default) or Gaussian with standard
+//           deviation a ("gauss"); with "%", a is that percentage of |v| at the cell.
+// Random deviates hash (seed, key, global cell index): the field is identical on any rank count.
+#pragma once
+
+#include "grid/grid.hpp"
+#include "io/png_file.hpp"
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+
+namespace mu {
+class Parser;
+}
+
+namespace morphogen {
+
+class ValueSpec {
+public:
+  // key: the option name (used in error messages and as the random stream name).
+  ValueSpec(const std::string& key, const std::string& text, const GridSpec& grid,
+            std::uint64_t seed, const std::string& base_dir = "");
+  ~ValueSpec();
+  ValueSpec(const ValueSpec&) = delete;
+  ValueSpec& operator=(const ValueSpec&) = delete;
+
+  const std::string& key() const { return key_; }
+  const std::string& text() const { return text_; }
+  // True when the value is the same number at every cell (no variables, no randomness).
+  bool is_constant() const { return constant_; }
+  double constant_value() const { return value_; }
+  bool uses_time() const { return uses_t_; }
+
+  // Value at global cell (i, j, k) (cell centre), at time t.
+  double at_cell(PetscInt i, PetscInt j, PetscInt k, double t = 0.0);
+  // Value at an arbitrary point (x, y, z); (i, j, k) name the cell whose deviates are used.
+  double at_point(double x, double y, double z, PetscInt i, PetscInt j, PetscInt k,
+                  double t = 0.0);
+
+private:
+  friend struct ValueSpecFunctions;
+  double eval_expr();
+  std::string where() const;
+
+  std::string key_, text_, base_dir_;
+  GridSpec grid_;
+  std::uint64_t seed_, stream_;
+  std::unique_ptr<mu::Parser> parser_;
+  bool constant_ = false, uses_t_ = false;
+  double value_ = 0.0;
+  enum class Perturb { None, Uniform, Gauss } perturb_ = Perturb::None;
+  double amount_ = 0.0;
+  bool percent_ = false;
+  // muParser variables and the cell being evaluated.
+  double x_ = 0, y_ = 0, z_ = 0, i_ = 0, j_ = 0, k_ = 0, r_ = 0, theta_ = 0, t_ = 0;
+  std::uint64_t cell_ = 0;
+  std::map<std::string, io::GreyImage> images_;
+};
+
+} // namespace morphogen

@@ -1,0 +1,65 @@
+#include "grid/grid.hpp"
+
+#include "core/user_error.hpp"
+
+#include <petscdmda.h>
+
+namespace morphogen {
+
+const char* boundary_name(Boundary b) {
+  switch (b) {
+  case Boundary::Periodic:
+    return "periodic";
+  case Boundary::Neumann:
+    return "neumann";
+  case Boundary::Dirichlet:
+    return "dirichlet";
+  }
+  return "?";
+}
+
+Grid::Grid(MPI_Comm comm, const GridSpec& spec) : spec_(spec) {
+  if (spec.dim == 2) {
+    spec_.n[2] = 1;
+    spec_.L[2] = spec_.h(0);
+    spec_.bc[2] = Boundary::Periodic;
+  }
+  auto dmbc = [&](int d) {
+    return spec_.bc[d] == Boundary::Periodic ? DM_BOUNDARY_PERIODIC : DM_BOUNDARY_GHOSTED;
+  };
+  const DMDAStencilType st = spec.box_stencil ? DMDA_STENCIL_BOX : DMDA_STENCIL_STAR;
+  if (spec.dim == 2) {
+    MG_PETSC(DMDACreate2d(comm, dmbc(0), dmbc(1), st, spec_.n[0], spec_.n[1], PETSC_DECIDE,
+                          PETSC_DECIDE, 1, spec.stencil_width, nullptr, nullptr, dm_.out()));
+  } else {
+    MG_PETSC(DMDACreate3d(comm, dmbc(0), dmbc(1), dmbc(2), st, spec_.n[0], spec_.n[1], spec_.n[2],
+                          PETSC_DECIDE, PETSC_DECIDE, PETSC_DECIDE, 1, spec.stencil_width, nullptr,
+                          nullptr, nullptr, dm_.out()));
+  }
+  MG_PETSC(DMSetUp(dm_));
+  MG_PETSC(DMDASetUniformCoordinates(dm_, 0.5 * spec_.h(0), spec_.L[0] - 0.5 * spec_.h(0),
+                                     0.5 * spec_.h(1), spec_.L[1] - 0.5 * spec_.h(1),
+                                     0.5 * spec_.h(2), spec_.L[2] - 0.5 * spec_.h(2)));
+  MG_PETSC(DMDAGetCorners(dm_, &owned_.s[0], &owned_.s[1], &owned_.s[2], &owned_.m[0],
+                          &owned_.m[1], &owned_.m[2]));
+  MG_PETSC(DMDAGetGhostCorners(dm_, &ghosted_.s[0], &ghosted_.s[1], &ghosted_.s[2],
+                               &ghosted_.m[0], &ghosted_.m[1], &ghosted_.m[2]));
+}
+
+MPI_Comm Grid::comm() const { return PetscObjectComm(reinterpret_cast<PetscObject>(dm_.get())); }
+
+VecH Grid::create_local() const {
+  VecH v;
+  MG_PETSC(DMCreateLocalVector(dm_, v.out()));
+  MG_PETSC(VecSet(v, 0.0));
+  return v;
+}
+
+VecH Grid::create_global() const {
+  VecH v;
+  MG_PETSC(DMCreateGlobalVector(dm_, v.out()));
+  MG_PETSC(VecSet(v, 0.0));
+  return v;
+}
+
+} // namespace morphogen

@@ -1,0 +1,124 @@
+#include "grid/halo.hpp"
+
+#include <petscdmda.h>
+
+namespace morphogen {
+
+namespace {
+
+// Owner rank and owner's ghosted-box geometry along one axis.
+struct AxisLayout {
+  std::vector<PetscInt> start; // first owned index per process along the axis
+  std::vector<PetscInt> count;
+  PetscInt owner(PetscInt i) const {
+    PetscInt p = 0;
+    while (p + 1 < static_cast<PetscInt>(start.size()) && i >= start[p + 1]) ++p;
+    return p;
+  }
+};
+
+} // namespace
+
+Halo::Halo(const Grid& grid) : grid_(grid) {
+  DM dm = grid.dm();
+  const GridSpec& g = grid.spec();
+  PetscInt P[3];
+  MG_PETSC(DMDAGetInfo(dm, nullptr, nullptr, nullptr, nullptr, &P[0], &P[1], &P[2], nullptr,
+                       nullptr, nullptr, nullptr, nullptr, nullptr));
+  const PetscInt* lx[3] = {nullptr, nullptr, nullptr};
+  MG_PETSC(DMDAGetOwnershipRanges(dm, &lx[0], &lx[1], &lx[2]));
+  AxisLayout ax[3];
+  const int sw = g.stencil_width;
+  for (int d = 0; d < 3; ++d) {
+    PetscInt s = 0;
+    for (PetscInt p = 0; p < P[d]; ++p) {
+      ax[d].start.push_back(s);
+      ax[d].count.push_back(d < grid.dim() ? lx[d][p] : 1);
+      s += d < grid.dim() ? lx[d][p] : 1;
+    }
+  }
+  const Box& gb = grid.ghosted();
+  const Box& ob = grid.owned();
+  std::vector<PetscInt> leaves;
+  std::vector<PetscSFNode> remotes;
+  for (PetscInt k = gb.s[2]; k < gb.s[2] + gb.m[2]; ++k)
+    for (PetscInt j = gb.s[1]; j < gb.s[1] + gb.m[1]; ++j)
+      for (PetscInt i = gb.s[0]; i < gb.s[0] + gb.m[0]; ++i) {
+        if (ob.contains(i, j, k)) continue;
+        PetscInt c[3] = {i, j, k};
+        bool inside = true;
+        for (int d = 0; d < 3 && inside; ++d) {
+          if (c[d] >= 0 && c[d] < g.n[d]) continue;
+          if (g.bc[d] != Boundary::Periodic) inside = false;
+          else c[d] = (c[d] % g.n[d] + g.n[d]) % g.n[d];
+        }
+        if (!inside) continue;
+        PetscInt p[3], gs[3], gm[3];
+        for (int d = 0; d < 3; ++d) {
+          p[d] = ax[d].owner(c[d]);
+          const bool has_ghost = d < grid.dim();
+          gs[d] = ax[d].start[p[d]] - (has_ghost ? sw : 0);
+          gm[d] = ax[d].count[p[d]] + (has_ghost ? 2 * sw : 0);
+        }
+        PetscSFNode r;
+        r.rank = static_cast<PetscInt>(p[0] + P[0] * (p[1] + P[1] * p[2]));
+        r.index = (c[0] - gs[0]) + gm[0] * ((c[1] - gs[1]) + gm[1] * (c[2] - gs[2]));
+        leaves.push_back(grid.local_index(i, j, k));
+        remotes.push_back(r);
+      }
+  MG_PETSC(PetscSFCreate(grid.comm(), sf_.out()));
+  MG_PETSC(PetscSFSetGraph(sf_, gb.size(), static_cast<PetscInt>(leaves.size()), leaves.data(),
+                           PETSC_COPY_VALUES, remotes.data(), PETSC_COPY_VALUES));
+  MG_PETSC(PetscSFSetUp(sf_));
+}
+
+void Halo::begin(double* a) const {
+  MG_PETSC(PetscSFBcastBegin(sf_, MPIU_SCALAR, a, a, MPI_REPLACE));
+}
+
+void Halo::end(double* a) const { MG_PETSC(PetscSFBcastEnd(sf_, MPIU_SCALAR, a, a, MPI_REPLACE)); }
+
+PetscInt Halo::face_size(int d) const {
+  const Box& gb = grid_.ghosted();
+  const int a = d == 0 ? 1 : 0, b = d == 2 ? 1 : 2;
+  return gb.m[a] * gb.m[b];
+}
+
+PetscInt Halo::face_index(int d, PetscInt i, PetscInt j, PetscInt k) const {
+  const Box& gb = grid_.ghosted();
+  const PetscInt c[3] = {i - gb.s[0], j - gb.s[1], k - gb.s[2]};
+  const int a = d == 0 ? 1 : 0, b = d == 2 ? 1 : 2;
+  return c[a] + gb.m[a] * c[b];
+}
+
+void Halo::fill_boundaries(double* u, const FaceValues* dirichlet) const {
+  const GridSpec& g = grid_.spec();
+  const Box& gb = grid_.ghosted();
+  const PetscInt str[3] = {1, gb.m[0], gb.m[0] * gb.m[1]};
+  for (int d = 0; d < grid_.dim(); ++d) {
+    if (g.bc[d] == Boundary::Periodic) continue;
+    const bool dir = g.bc[d] == Boundary::Dirichlet;
+    for (int side = 0; side < 2; ++side) {
+      // Ghost layers beyond this face owned by this rank's ghost box.
+      for (PetscInt layer = 1; layer <= g.stencil_width; ++layer) {
+        const PetscInt ghost = side == 0 ? -layer : g.n[d] - 1 + layer;
+        const PetscInt mirror = side == 0 ? layer - 1 : g.n[d] - layer; // reflected cell
+        if (ghost < gb.s[d] || ghost >= gb.s[d] + gb.m[d]) continue;
+        const std::vector<double>* vals = dir ? &dirichlet->face[2 * d + side] : nullptr;
+        PetscInt lo[3] = {gb.s[0], gb.s[1], gb.s[2]}, hi[3];
+        for (int e = 0; e < 3; ++e) hi[e] = gb.s[e] + gb.m[e];
+        lo[d] = ghost;
+        hi[d] = ghost + 1;
+        for (PetscInt k = lo[2]; k < hi[2]; ++k)
+          for (PetscInt j = lo[1]; j < hi[1]; ++j)
+            for (PetscInt i = lo[0]; i < hi[0]; ++i) {
+              const PetscInt gi = grid_.local_index(i, j, k);
+              const PetscInt mi = gi + (mirror - ghost) * str[d];
+              u[gi] = dir ? 2.0 * (*vals)[face_index(d, i, j, k)] - u[mi] : u[mi];
+            }
+      }
+    }
+  }
+}
+
+} // namespace morphogen

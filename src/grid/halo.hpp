@@ -1,0 +1,50 @@
+// Halo update of a ghosted local array, in place, without copying owned values.
+//
+// Ghost cells whose (periodically wrapped) position lies inside the domain are received from
+// their owner through one PetscSF whose roots and leaves are both positions in the ghosted local
+// arrays (halo-only: no global-to-local copy of the interior). Ghost cells outside a
+// non-periodic boundary are then filled axis by axis (x, then y, then z, so box-stencil corners
+// come out right), for the cell-centred grid:
+//   zero flux (Neumann):  u_ghost = u_inside                 (du/dn = 0 at the face)
+//   Dirichlet value g:    u_ghost = 2 g - u_inside           (u = g at the face, 2nd order)
+#pragma once
+
+#include "grid/grid.hpp"
+
+#include <vector>
+
+namespace morphogen {
+
+// Dirichlet values of one field on the six faces (lo/hi per axis). face[2*d + side] is indexed
+// over the ghosted box of the other two axes, x fastest (see Halo::face_index).
+struct FaceValues {
+  std::array<std::vector<double>, 6> face;
+};
+
+class Halo {
+public:
+  explicit Halo(const Grid& grid);
+
+  // Start / finish the exchange of inter-rank and periodic ghosts of `a` (ghosted local array).
+  void begin(double* a) const;
+  void end(double* a) const;
+  // Fill ghosts outside non-periodic boundaries (after end()). `dirichlet` may be null when no
+  // axis is Dirichlet.
+  void fill_boundaries(double* a, const FaceValues* dirichlet) const;
+  // The whole update: begin, end, fill_boundaries.
+  void update(double* a, const FaceValues* dirichlet) const {
+    begin(a);
+    end(a);
+    fill_boundaries(a, dirichlet);
+  }
+
+  // Position (in the face array of axis d) of ghosted-box cell (i,j,k): the other two axes' offsets.
+  PetscInt face_index(int d, PetscInt i, PetscInt j, PetscInt k) const;
+  PetscInt face_size(int d) const;
+
+private:
+  const Grid& grid_;
+  SFH sf_;
+};
+
+} // namespace morphogen

@@ -1,0 +1,94 @@
+#include "integrators/explicit_integrator.hpp"
+
+#include <limits>
+#include <utility>
+
+namespace morphogen {
+
+ExplicitIntegrator::ExplicitIntegrator(const Grid& grid, const Halo& halo, RowFn row_fn,
+                                       int nspecies, const Stencil& stencil, std::vector<double> D,
+                                       std::vector<double> floor, const ParamSet& params,
+                                       const std::vector<FaceValues>* dirichlet)
+    : grid_(grid), halo_(halo), row_fn_(row_fn), ns_(nspecies), stencil_(stencil),
+      D_(std::move(D)), floor_(std::move(floor)), params_(params), dirichlet_(dirichlet) {
+  if (params_.any_field())
+    for (size_t q = 0; q < params_.scalar.size(); ++q)
+      const_rows_.emplace_back(params_.field[q].get() ? 0 : grid.owned().m[0],
+                               params_.scalar[q]);
+}
+
+double ExplicitIntegrator::stable_dt(const Stencil& stencil, const std::vector<double>& D) {
+  double dmax = 0;
+  for (double d : D) dmax = std::max(dmax, d);
+  const double rho = stencil.spectral_radius();
+  return dmax > 0 && rho > 0 ? 2.0 / (dmax * rho) : std::numeric_limits<double>::infinity();
+}
+
+void ExplicitIntegrator::update_ghosts(std::vector<VecH>& u) const {
+  std::vector<PetscScalar*> a(ns_);
+  for (int s = 0; s < ns_; ++s) MG_PETSC(VecGetArray(u[s], &a[s]));
+  for (int s = 0; s < ns_; ++s) halo_.begin(a[s]);
+  for (int s = 0; s < ns_; ++s) {
+    halo_.end(a[s]);
+    halo_.fill_boundaries(a[s], dirichlet_ ? &(*dirichlet_)[s] : nullptr);
+  }
+  for (int s = 0; s < ns_; ++s) MG_PETSC(VecRestoreArray(u[s], &a[s]));
+}
+
+void ExplicitIntegrator::step(std::vector<VecH>& u, std::vector<VecH>& work, double dt) const {
+  update_ghosts(u);
+  const int nt = stencil_.nterms;
+  const int np = static_cast<int>(params_.scalar.size());
+  const bool field_mode = params_.any_field();
+  std::vector<const PetscScalar*> in(ns_);
+  std::vector<PetscScalar*> out(ns_);
+  std::vector<const PetscScalar*> pf(np, nullptr);
+  for (int s = 0; s < ns_; ++s) {
+    MG_PETSC(VecGetArrayRead(u[s], &in[s]));
+    MG_PETSC(VecGetArray(work[s], &out[s]));
+  }
+  for (int q = 0; q < np; ++q)
+    if (params_.field[q].get()) MG_PETSC(VecGetArrayRead(params_.field[q], &pf[q]));
+
+  const Box& ob = grid_.owned();
+  const PetscInt gx = grid_.ghosted().m[0], gxy = gx * grid_.ghosted().m[1];
+  std::vector<PetscInt> delta(nt);
+  for (int t = 0; t < nt; ++t)
+    delta[t] = stencil_.off[t][0] + gx * stencil_.off[t][1] + gxy * stencil_.off[t][2];
+  std::vector<const double*> src(static_cast<size_t>(ns_ * nt));
+  std::vector<double*> dst(ns_);
+  std::vector<const double*> prow(np, nullptr);
+  ExplicitRow row;
+  row.n = static_cast<int>(ob.m[0]);
+  row.src = src.data();
+  row.w = stencil_.w.data();
+  row.D = D_.data();
+  row.floor = floor_.data();
+  row.prow = prow.data();
+  row.pconst = params_.scalar.data();
+  row.dt = dt;
+  row.dst = dst.data();
+  for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
+    for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j) {
+      const PetscInt c = grid_.local_index(ob.s[0], j, k);
+      for (int s = 0; s < ns_; ++s) {
+        for (int t = 0; t < nt; ++t) src[s * nt + t] = in[s] + c + delta[t];
+        dst[s] = out[s] + c;
+      }
+      if (field_mode) {
+        const PetscInt o = grid_.owned_index(ob.s[0], j, k);
+        for (int q = 0; q < np; ++q) prow[q] = pf[q] ? pf[q] + o : const_rows_[q].data();
+      }
+      row_fn_(row);
+    }
+
+  for (int q = 0; q < np; ++q)
+    if (pf[q]) MG_PETSC(VecRestoreArrayRead(params_.field[q], &pf[q]));
+  for (int s = 0; s < ns_; ++s) {
+    MG_PETSC(VecRestoreArrayRead(u[s], &in[s]));
+    MG_PETSC(VecRestoreArray(work[s], &out[s]));
+  }
+  std::swap(u, work);
+}
+
+} // namespace morphogen

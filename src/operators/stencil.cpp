@@ -1,0 +1,39 @@
+#include "operators/stencil.hpp"
+
+namespace morphogen {
+
+bool make_stencil(const std::string& name, int dim, const double* h, Stencil& s) {
+  Stencil r;
+  r.name = name;
+  if ((name == "5pt" && dim == 2) || (name == "7pt" && dim == 3)) {
+    double centre = 0;
+    for (int d = 0; d < dim; ++d) centre -= 2.0 / (h[d] * h[d]);
+    r.add(0, 0, 0, centre);
+    for (int d = 0; d < dim; ++d) {
+      const double w = 1.0 / (h[d] * h[d]);
+      int o[3] = {0, 0, 0};
+      o[d] = -1;
+      r.add(o[0], o[1], o[2], w);
+      o[d] = 1;
+      r.add(o[0], o[1], o[2], w);
+    }
+  } else if (name == "9pt" && dim == 2) {
+    if (std::abs(h[0] - h[1]) > 1e-12 * h[0]) return false;
+    const double s6 = 1.0 / (6.0 * h[0] * h[0]);
+    r.add(0, 0, 0, -20.0 * s6);
+    r.add(-1, 0, 0, 4.0 * s6);
+    r.add(1, 0, 0, 4.0 * s6);
+    r.add(0, -1, 0, 4.0 * s6);
+    r.add(0, 1, 0, 4.0 * s6);
+    r.add(-1, -1, 0, s6);
+    r.add(1, -1, 0, s6);
+    r.add(-1, 1, 0, s6);
+    r.add(1, 1, 0, s6);
+  } else {
+    return false;
+  }
+  s = r;
+  return true;
+}
+
+} // namespace morphogen

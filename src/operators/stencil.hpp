@@ -1,0 +1,58 @@
+// Discrete Laplacians as weighted neighbour offsets (pure data, no PETSc).
+//
+//   5pt (2-D):  lap u = (u[i-1]-2u+u[i+1])/hx^2 + (u[j-1]-2u+u[j+1])/hy^2
+//   7pt (3-D):  the same plus the z pair over hz^2
+//   9pt (2-D, hx = hy = h): the isotropic stencil of the Garrity/Sims code,
+//       lap u = (4 (N+S+E+W) + (NE+NW+SE+SW) - 20 u) / (6 h^2)
+//     = (20 / (6 h^2)) (0.2 (N+S+E+W) + 0.05 (diagonals) - u); Garrity's unscaled operator
+//       with diffusion rate d equals this Laplacian with D = 0.3 d h^2.
+// All are second-order accurate and exact on quadratics. Term 0 is always the centre.
+// spectral_radius() is max |symbol| over the grid's Nyquist corners: the explicit Euler step
+// is stable for dt * D_max * spectral_radius <= 2.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <string>
+
+namespace morphogen {
+
+struct Stencil {
+  std::string name;
+  int nterms = 0;
+  std::array<std::array<int, 3>, 27> off{};
+  std::array<double, 27> w{};
+
+  void add(int dx, int dy, int dz, double weight) {
+    off[nterms] = {dx, dy, dz};
+    w[nterms] = weight;
+    ++nterms;
+  }
+  // Largest |eigenvalue| of the stencil operator on a periodic grid.
+  double spectral_radius() const {
+    double best = 0;
+    for (int c = 0; c < 8; ++c) {
+      double s = 0;
+      for (int t = 0; t < nterms; ++t) {
+        double phase = 1;
+        for (int d = 0; d < 3; ++d)
+          if ((c >> d) & 1) phase *= (off[t][d] % 2 == 0) ? 1.0 : -1.0;
+        s += w[t] * phase;
+      }
+      best = std::max(best, std::abs(s));
+    }
+    return best;
+  }
+  // Apply to a function sampled at offsets (for tests): sum_t w_t f(off_t).
+  template <class F> double apply(F&& f) const {
+    double s = 0;
+    for (int t = 0; t < nterms; ++t) s += w[t] * f(off[t][0], off[t][1], off[t][2]);
+    return s;
+  }
+};
+
+// Names accepted by make_stencil for the given dimension: "5pt" and "9pt" in 2-D, "7pt" in 3-D.
+// Returns false (stencil untouched) for an unknown name or a 9pt stencil with hx != hy.
+bool make_stencil(const std::string& name, int dim, const double* h, Stencil& out);
+
+} // namespace morphogen
