@@ -170,8 +170,11 @@ void Simulation::read_model(Options& opt, const std::string& base_dir) {
                 for (PetscInt i = gb.s[0]; i < gb.s[0] + gb.m[0]; ++i) {
                   PetscInt c[3] = {i, j, k};
                   if (c[d] != gb.s[d]) continue; // one entry per face position
-                  double x[3] = {grid_->centre(0, i), grid_->centre(1, j),
-                                 spec_.dim == 3 ? grid_->centre(2, k) : 0.0};
+                  for (int e = 0; e < spec_.dim; ++e) // periodic images share face values
+                    if (spec_.bc[e] == Boundary::Periodic)
+                      c[e] = (c[e] % spec_.n[e] + spec_.n[e]) % spec_.n[e];
+                  double x[3] = {grid_->centre(0, c[0]), grid_->centre(1, c[1]),
+                                 spec_.dim == 3 ? grid_->centre(2, c[2]) : 0.0};
                   x[d] = side == 0 ? 0.0 : spec_.L[d];
                   c[d] = side == 0 ? 0 : spec_.n[d] - 1;
                   face[halo_->face_index(d, i, j, k)] = g.at_point(x[0], x[1], x[2], c[0], c[1], c[2]);
