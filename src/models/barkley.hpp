@@ -11,7 +11,7 @@
 // Barkley's "turbulent" variant (same appendix) replaces the recovery kinetics by
 //   dB/dt = A^3 - B,
 // which delays recovery and lets spirals break up into spatiotemporal chaos. Its defaults
-// differ (our choice): a = 0.75, b = 0.06, eps = 0.08 — we checked that a broken wave there
+// differ (our choice): a = 0.75, b = 0.06, eps = 0.08; we checked that a broken wave there
 // becomes a spiral whose core breaks up into turbulence that fills the domain, while with
 // the regular model's defaults the variant only gives a stable, tightly wound spiral.
 #pragma once
@@ -53,7 +53,7 @@ struct Barkley {
   }};
   static constexpr std::array<ParamInfo, 3> params{{
       {"a", 0.75, 1e-6, 1e3, "threshold scale: threshold is (B + b) / a"},
-      {"b", 0.02, -1e3, 1e3, "threshold offset (excitability)"},
+      {"b", 0.02, 0.0, 1e3, "threshold offset (excitability)"},
       {"eps", 0.02, 1e-6, 1e3, "time-scale ratio of A to B (small: stiff, sharp fronts)"},
   }};
   static constexpr bool clamp_default = false;
@@ -86,7 +86,7 @@ struct BarkleyTurbulent {
   }};
   static constexpr std::array<ParamInfo, 3> params{{
       {"a", 0.75, 1e-6, 1e3, "threshold scale: threshold is (B + b) / a"},
-      {"b", 0.06, -1e3, 1e3, "threshold offset (excitability)"},
+      {"b", 0.06, 0.0, 1e3, "threshold offset (excitability)"},
       {"eps", 0.08, 1e-6, 1e3, "time-scale ratio of A to B (small: stiff, sharp fronts)"},
   }};
   static constexpr bool clamp_default = false;

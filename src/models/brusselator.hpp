@@ -15,7 +15,8 @@ namespace morphogen::models {
 
 struct Brusselator {
   static constexpr const char* name = "brusselator";
-  static constexpr const char* doc = "Brusselator: depletion model, spots (double spots when coupled)";
+  static constexpr const char* doc =
+      "Brusselator: depletion model, spots (double spots when coupled)";
   static constexpr const char* reference = "Sanderson et al. 2006, eqs. 7-8";
   static constexpr int nspecies = 2;
   static constexpr int nparams = 3;

@@ -24,7 +24,8 @@ namespace morphogen::models {
 
 struct FitzHughNagumo {
   static constexpr const char* name = "fitzhugh_nagumo";
-  static constexpr const char* doc = "FitzHugh-Nagumo model: labyrinths, fronts and travelling waves";
+  static constexpr const char* doc =
+      "FitzHugh-Nagumo model: labyrinths, fronts and travelling waves";
   static constexpr const char* reference =
       "Stable advection-reaction-diffusion with arbitrary anisotropy, Appendix A";
   static constexpr int nspecies = 2;
