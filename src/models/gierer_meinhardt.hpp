@@ -6,11 +6,12 @@
 // production of a. Homogeneous steady state: a* = (gamma + beta) / alpha, b* = a*^2 / beta.
 // The paper gives no values, so the defaults are our choice: alpha = 1, beta = 1.5,
 // gamma = 0.1, s = 0.5, D_a = 1, D_b = 20. Then (a*, b*) = (1.6, 1.70667); without diffusion
-// the state is a stable focus (eigenvalues -0.156 +- 0.47i), and with the default D it is
-// Turing-unstable for wavelengths of about 10-60 grid units at unit spacing, the fastest
+// the state is a stable focus (eigenvalues -0.156 +- 0.592i), and with the default D it is
+// Turing-unstable for wavelengths of about 10.7-27 grid units at unit spacing, the fastest
 // growing one about 16.5 (growth rate 0.105); a noisy start gives a hexagonal spot pattern.
-// Wider spacing needs D_b / D_a > 5.83 beta / alpha roughly (gamma = 0). The dynamics keep
-// a, b > 0; b = 0 is a pole, so clamping (to 0) would not help and is off.
+// (With gamma = 0 a Turing instability needs beta > alpha and D_b / D_a > (1 + sqrt 2)^2
+// beta / alpha.) The dynamics keep a, b > 0 for gamma >= 0; b = 0 is a pole, so clamping
+// negatives to 0 would not help, and it is off.
 #pragma once
 
 #include "models/model.hpp"

@@ -12,9 +12,9 @@
 // The paper gives no values, so the defaults are our choice: s = 1, alpha = 100 (c = 1, so A
 // and B are both of order 1), p1 = -1, p2 = -1.5, p3 = 0.05, D_A = 1, D_B = 20. Then
 // (A*, B*) = (1.55, 1.601667); without diffusion the state is stable (eigenvalues
-// -0.282 +- 0.93i) and with the default D it is Turing-unstable, fastest-growing wavelength
+// -0.282 +- 1.19i) and with the default D it is Turing-unstable, fastest-growing wavelength
 // about 11.6 grid units at unit spacing (growth rate 0.26): a noisy start gives spots.
-// B = 0 is a pole, so clamping (to 0) would not help and is off.
+// B = 0 is a pole, so clamping negatives to 0 would not help, and it is off.
 #pragma once
 
 #include "models/model.hpp"

@@ -5,8 +5,8 @@
 //   2. the analytic Jacobian against central finite differences at three states,
 //   3. a zero residual at the steady state, and that the default initial values are that state,
 //   4. consistent metadata (ranges contain the defaults, unique identifier-like names),
-//   5. for the Turing-type models, linear stability of the steady state with the default
-//      parameters and diffusion: stable without diffusion, unstable to some wavenumber k.
+//   5. linear stability of the steady state with the default parameters and diffusion; for
+//      the Turing-type models: stable without diffusion, unstable to some wavenumber k.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -14,6 +14,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <set>
 #include <string>
 #include <tuple>
@@ -26,14 +27,16 @@ namespace {
 using namespace morphogen;
 namespace mm = morphogen::models;
 
+// Linear stability of the default steady state to modes exp(i k x) with the default D.
 enum class TuringKind {
-  none,     // not a Turing-type model (or not at its defaults)
-  unstable, // stable at k = 0, some k > 0 grows
-  marginal, // stable at k = 0, the fastest k sits exactly at zero growth
+  unstable,    // Turing-type: stable at k = 0, some k > 0 grows
+  marginal,    // Turing-type at its critical point: stable at k = 0, fastest k has zero growth
+  stable,      // stable at every k (Gray-Scott, excitable rest states): needs a finite seed
+  unstable_k0, // unstable without diffusion (oscillatory or bistable medium)
 };
 
 // Per-model test data: a state u with the hand-computed rates r at the default parameters,
-// three states for the Jacobian check, and the kind of Turing behaviour expected.
+// three states for the Jacobian check, and the linear stability expected.
 template <class M> struct Case;
 
 template <> struct Case<mm::Turing> {
@@ -53,7 +56,7 @@ template <> struct Case<mm::GrayScott> {
   static constexpr std::array<double, 2> u{0.5, 0.25};
   static constexpr std::array<double, 2> r{0.0125, -0.0325};
   static constexpr std::array<std::array<double, 2>, 3> jac{{{0.25, 0.5}, {0.1, 0.9}, {0.4, 0.2}}};
-  static constexpr TuringKind turing = TuringKind::none;
+  static constexpr TuringKind turing = TuringKind::stable;
 };
 
 template <> struct Case<mm::GrayScottSims> {
@@ -62,7 +65,7 @@ template <> struct Case<mm::GrayScottSims> {
   static constexpr std::array<double, 2> u{0.5, 0.25};
   static constexpr std::array<double, 2> r{-0.00375, 0.002};
   static constexpr std::array<std::array<double, 2>, 3> jac{{{1.0, 0.0}, {0.3, 0.4}, {0.6, 0.2}}};
-  static constexpr TuringKind turing = TuringKind::none;
+  static constexpr TuringKind turing = TuringKind::stable;
 };
 
 template <> struct Case<mm::Brusselator> {
@@ -107,7 +110,7 @@ template <> struct Case<mm::FitzHughNagumo> {
   static constexpr std::array<double, 2> u{0.5, 0.1};
   static constexpr std::array<double, 2> r{0.275, 0.015};
   static constexpr std::array<std::array<double, 2>, 3> jac{{{0.0, 0.0}, {0.7, -0.3}, {-1.1, 0.4}}};
-  static constexpr TuringKind turing = TuringKind::none;
+  static constexpr TuringKind turing = TuringKind::unstable_k0;
 };
 
 template <> struct Case<mm::Barkley> {
@@ -116,7 +119,7 @@ template <> struct Case<mm::Barkley> {
   static constexpr std::array<double, 2> u{0.5, 0.25};
   static constexpr std::array<double, 2> r{1.75, 0.25};
   static constexpr std::array<std::array<double, 2>, 3> jac{{{0.0, 0.0}, {0.5, 0.2}, {0.95, 0.6}}};
-  static constexpr TuringKind turing = TuringKind::none;
+  static constexpr TuringKind turing = TuringKind::stable;
 };
 
 template <> struct Case<mm::BarkleyTurbulent> {
@@ -125,7 +128,7 @@ template <> struct Case<mm::BarkleyTurbulent> {
   static constexpr std::array<double, 2> u{0.5, 0.25};
   static constexpr std::array<double, 2> r{13.0 / 48.0, -0.125};
   static constexpr std::array<std::array<double, 2>, 3> jac{{{0.0, 0.0}, {0.5, 0.2}, {0.95, 0.6}}};
-  static constexpr TuringKind turing = TuringKind::none;
+  static constexpr TuringKind turing = TuringKind::stable;
 };
 
 template <> struct Case<mm::Oregonator> {
@@ -135,7 +138,7 @@ template <> struct Case<mm::Oregonator> {
   static constexpr std::array<double, 2> r{-913.0 / 102.0, -0.1};
   static constexpr std::array<std::array<double, 2>, 3> jac{
       {{0.0116, 0.0116}, {0.1, 0.2}, {0.8, 0.05}}};
-  static constexpr TuringKind turing = TuringKind::none;
+  static constexpr TuringKind turing = TuringKind::unstable_k0;
 };
 
 template <class Tuple> struct ToTypes;
@@ -247,57 +250,64 @@ double growth_rate(const std::array<double, 4>& J, const std::array<double, 2>& 
   return 0.5 * tr + (disc > 0.0 ? std::sqrt(disc) : 0.0);
 }
 
+// Largest growth rate over k in [0, pi] (pi: the Nyquist limit of a unit-spacing grid), by a
+// coarse scan and golden-section refinement around the best sample. Returns {k, rate}.
+std::array<double, 2> fastest_mode(const std::array<double, 4>& J, const std::array<double, 2>& D) {
+  const double kmax = std::numbers::pi;
+  const int n = 20000;
+  double kb = 0.0, gb = growth_rate(J, D, 0.0);
+  for (int i = 1; i <= n; ++i) {
+    const double k = kmax * i / n, g = growth_rate(J, D, k);
+    if (g > gb) gb = g, kb = k;
+  }
+  double lo = std::max(0.0, kb - kmax / n), hi = std::min(kmax, kb + kmax / n);
+  const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
+  for (int it = 0; it < 100; ++it) {
+    const double k1 = hi - phi * (hi - lo), k2 = lo + phi * (hi - lo);
+    if (growth_rate(J, D, k1) < growth_rate(J, D, k2))
+      lo = k1;
+    else
+      hi = k2;
+  }
+  kb = 0.5 * (lo + hi);
+  return {kb, growth_rate(J, D, kb)};
+}
+
 TYPED_TEST(ModelTest, LinearStabilityOfTheSteadyState) {
   using M = TypeParam;
   constexpr TuringKind kind = Case<M>::turing;
-  if constexpr (kind == TuringKind::none) {
-    GTEST_SKIP() << M::name << " is not a Turing-type model at its defaults";
+  static_assert(M::nspecies == 2);
+  const auto p = defaults<M>();
+  std::array<double, 2> u{};
+  ASSERT_TRUE(M::steady_state(p.data(), u.data()));
+  std::array<double, 4> J{};
+  M::jacobian(u.data(), p.data(), J.data());
+  const std::array<double, 2> D{M::species[0].D, M::species[1].D};
+  const double tr = J[0] + J[3], det = J[0] * J[3] - J[1] * J[2];
+  double scale = 0.0;
+  for (double x : J)
+    scale = std::max(scale, std::fabs(x));
+  const auto [kb, gb] = fastest_mode(J, D);
+
+  if constexpr (kind == TuringKind::unstable_k0) {
+    EXPECT_GT(growth_rate(J, D, 0.0), 0.0) << "tr " << tr << ", det " << det;
   } else {
-    static_assert(M::nspecies == 2);
-    const auto p = defaults<M>();
-    std::array<double, 2> u{};
-    ASSERT_TRUE(M::steady_state(p.data(), u.data()));
-    std::array<double, 4> J{};
-    M::jacobian(u.data(), p.data(), J.data());
-    const std::array<double, 2> D{M::species[0].D, M::species[1].D};
-
     // Stable without diffusion: trace < 0 and det > 0 (both eigenvalues in the left half-plane).
-    EXPECT_LT(J[0] + J[3], 0.0);
-    EXPECT_GT(J[0] * J[3] - J[1] * J[2], 0.0);
+    EXPECT_LT(tr, 0.0);
+    EXPECT_GT(det, 0.0);
     EXPECT_LT(growth_rate(J, D, 0.0), 0.0);
-
-    // Fastest-growing wavenumber on [0, pi] (pi: the Nyquist limit of a unit-spacing grid):
-    // a coarse scan, then golden-section refinement around the best sample.
-    const double kmax = M_PI;
-    const int n = 20000;
-    double kb = 0.0, gb = growth_rate(J, D, 0.0);
-    for (int i = 1; i <= n; ++i) {
-      const double k = kmax * i / n, g = growth_rate(J, D, k);
-      if (g > gb) gb = g, kb = k;
-    }
-    double lo = std::max(0.0, kb - kmax / n), hi = std::min(kmax, kb + kmax / n);
-    const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
-    for (int it = 0; it < 100; ++it) {
-      const double k1 = hi - phi * (hi - lo), k2 = lo + phi * (hi - lo);
-      if (growth_rate(J, D, k1) < growth_rate(J, D, k2))
-        lo = k1;
-      else
-        hi = k2;
-    }
-    kb = 0.5 * (lo + hi);
-    gb = growth_rate(J, D, kb);
-    std::printf("[ %s ] fastest-growing k = %.6f, wavelength 2 pi / k = %.3f grid units, "
-                "growth rate %.6g\n",
-                M::name, kb, 2.0 * M_PI / kb, gb);
-    EXPECT_GT(kb, 0.0);
-    EXPECT_LT(kb, kmax) << "fastest mode not resolved on a unit-spacing grid";
-    if constexpr (kind == TuringKind::unstable) {
-      EXPECT_GT(gb, 0.0) << "no Turing instability";
+    if constexpr (kind == TuringKind::stable) {
+      EXPECT_LT(gb, 0.0) << "mode k = " << kb << " grows";
     } else {
-      double scale = 0.0;
-      for (double x : J)
-        scale = std::max(scale, std::fabs(x));
-      EXPECT_NEAR(gb, 0.0, 1e-9 * scale) << "expected a marginal (critical) Turing mode";
+      std::printf("[ %s ] fastest-growing k = %.6f, wavelength 2 pi / k = %.3f grid units, "
+                  "growth rate %.6g\n",
+                  M::name, kb, 2.0 * std::numbers::pi / kb, gb);
+      EXPECT_GT(kb, 0.0);
+      EXPECT_LT(kb, std::numbers::pi) << "fastest mode not resolved on a unit-spacing grid";
+      if constexpr (kind == TuringKind::unstable)
+        EXPECT_GT(gb, 0.0) << "no Turing instability";
+      else
+        EXPECT_NEAR(gb, 0.0, 1e-9 * scale) << "expected a marginal (critical) Turing mode";
     }
   }
 }
