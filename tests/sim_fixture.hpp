@@ -15,7 +15,8 @@ using OptionList = std::vector<std::pair<std::string, std::string>>;
 
 inline void set_options(const OptionList& opts) {
   PetscOptionsClear(nullptr);
-  for (const auto& [k, v] : opts) PetscOptionsSetValue(nullptr, ("-" + k).c_str(), v.c_str());
+  for (const auto& [k, v] : opts)
+    PetscOptionsSetValue(nullptr, ("-" + k).c_str(), v.c_str());
 }
 
 inline std::unique_ptr<Simulation> make_sim(MPI_Comm comm, const OptionList& opts) {

@@ -8,7 +8,7 @@
 
 namespace morphogen {
 
-extern const char* const kDefaultDeck;     // input/turing_spots.yaml, embedded at build time
+extern const char* const kDefaultDeck; // input/turing_spots.yaml, embedded at build time
 extern const char* const kDefaultDeckName;
 
 // argv[1], if it does not start with '-', is the deck path.

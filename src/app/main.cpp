@@ -70,9 +70,11 @@ int run(int* argc, char*** argv) {
   const auto& g = sim.grid().spec();
   PetscPrintf(comm, "morphogen %s: model %s, grid %lld", MORPHOGEN_VERSION, sim.model().name,
               static_cast<long long>(g.n[0]));
-  for (int d = 1; d < g.dim; ++d) PetscPrintf(comm, "x%lld", static_cast<long long>(g.n[d]));
+  for (int d = 1; d < g.dim; ++d)
+    PetscPrintf(comm, "x%lld", static_cast<long long>(g.n[d]));
   PetscPrintf(comm, " (%s", boundary_name(g.bc[0]));
-  for (int d = 1; d < g.dim; ++d) PetscPrintf(comm, ",%s", boundary_name(g.bc[d]));
+  for (int d = 1; d < g.dim; ++d)
+    PetscPrintf(comm, ",%s", boundary_name(g.bc[d]));
   PetscPrintf(comm, "), %s stencil, dt %g (explicit bound %g), %lld steps, %d rank%s -> %s/\n",
               sim.stencil().name.c_str(), sim.dt(), sim.stable_dt(),
               static_cast<long long>(sim.steps()), size, size == 1 ? "" : "s",

@@ -55,7 +55,8 @@ const ModelEntry* find_model(const std::string& name) {
 
 std::vector<std::string> model_names() {
   std::vector<std::string> out;
-  for (const auto& e : model_registry()) out.emplace_back(e.name);
+  for (const auto& e : model_registry())
+    out.emplace_back(e.name);
   return out;
 }
 

@@ -57,7 +57,8 @@ void run_loop(Simulation& sim) {
     }
     if (n % out.progress_every == 0 || n == steps) {
       const double now = MPI_Wtime();
-      const double rate = (now - t_last) > 0 ? cells * static_cast<double>(n - step_last) / (now - t_last) : 0;
+      const double rate =
+          (now - t_last) > 0 ? cells * static_cast<double>(n - step_last) / (now - t_last) : 0;
       const double elapsed = now - t0;
       const double eta = elapsed / static_cast<double>(n) * static_cast<double>(steps - n);
       MG_PETSC(PetscPrintf(comm,

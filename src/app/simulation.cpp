@@ -22,8 +22,8 @@ Simulation::Simulation(MPI_Comm comm, Options& opt, const std::string& base_dir)
 }
 
 void Simulation::read_grid(Options& opt) {
-  const auto n = opt.list("grid_n", {"256", "256"}, 2, 3,
-                          "cells per axis: nx,ny (2-D) or nx,ny,nz (3-D)");
+  const auto n =
+      opt.list("grid_n", {"256", "256"}, 2, 3, "cells per axis: nx,ny (2-D) or nx,ny,nz (3-D)");
   spec_.dim = static_cast<int>(n.size());
   for (int d = 0; d < spec_.dim; ++d) {
     spec_.n[d] = Options::parse_int("grid_n", n[d]);
@@ -31,7 +31,8 @@ void Simulation::read_grid(Options& opt) {
       throw UserError("-grid_n " + n[d] + ": cells per axis must be in [3, 16777216]");
   }
   std::vector<std::string> Ldef;
-  for (int d = 0; d < spec_.dim; ++d) Ldef.push_back(std::to_string(spec_.n[d]));
+  for (int d = 0; d < spec_.dim; ++d)
+    Ldef.push_back(std::to_string(spec_.n[d]));
   const auto L = opt.list("grid_L", Ldef, 1, 3,
                           "domain length per axis (one value for all axes); spacing h = L/n");
   for (int d = 0; d < spec_.dim; ++d) {
@@ -51,20 +52,24 @@ void Simulation::read_grid(Options& opt) {
                     std::to_string(bc.size()));
   for (int d = 0; d < spec_.dim; ++d) {
     const std::string& b = bc.size() == 1 ? bc[0] : bc[d];
-    if (b == "periodic") spec_.bc[d] = Boundary::Periodic;
-    else if (b == "neumann" || b == "zero_flux") spec_.bc[d] = Boundary::Neumann;
-    else if (b == "dirichlet") spec_.bc[d] = Boundary::Dirichlet;
-    else throw UserError("-grid_bc " + b + ": unknown boundary, allowed periodic, neumann, dirichlet");
+    if (b == "periodic")
+      spec_.bc[d] = Boundary::Periodic;
+    else if (b == "neumann" || b == "zero_flux")
+      spec_.bc[d] = Boundary::Neumann;
+    else if (b == "dirichlet")
+      spec_.bc[d] = Boundary::Dirichlet;
+    else
+      throw UserError("-grid_bc " + b + ": unknown boundary, allowed periodic, neumann, dirichlet");
   }
   const std::string def_stencil = spec_.dim == 2 ? "5pt" : "7pt";
-  const std::string st =
-      opt.choice("stencil", def_stencil,
-                 spec_.dim == 2 ? std::vector<std::string>{"5pt", "9pt"}
-                                : std::vector<std::string>{"7pt"},
-                 "Laplacian stencil: 5pt or 9pt (isotropic, Garrity) in 2-D, 7pt in 3-D");
+  const std::string st = opt.choice(
+      "stencil", def_stencil,
+      spec_.dim == 2 ? std::vector<std::string>{"5pt", "9pt"} : std::vector<std::string>{"7pt"},
+      "Laplacian stencil: 5pt or 9pt (isotropic, Garrity) in 2-D, 7pt in 3-D");
   const double h[3] = {spec_.h(0), spec_.h(1), spec_.h(2)};
   if (!make_stencil(st, spec_.dim, h, stencil_))
-    throw UserError("-stencil " + st + ": the isotropic 9pt stencil needs equal spacing hx = hy (got " +
+    throw UserError("-stencil " + st +
+                    ": the isotropic 9pt stencil needs equal spacing hx = hy (got " +
                     format_double(h[0]) + " and " + format_double(h[1]) + ")");
   spec_.stencil_width = 1;
   spec_.box_stencil = stencil_.nterms == 9;
@@ -94,8 +99,9 @@ void Simulation::read_model(Options& opt, const std::string& base_dir) {
     ValueSpec vs(key, text, spec_, seed_, base_dir);
     params_.names.emplace_back(p.name);
     if (vs.uses_time())
-      throw UserError("-" + key + " " + text +
-                      ": time-dependent parameters (t) are not supported by the explicit integrator yet");
+      throw UserError(
+          "-" + key + " " + text +
+          ": time-dependent parameters (t) are not supported by the explicit integrator yet");
     if (vs.is_constant()) {
       const double v = vs.constant_value();
       if (!(v >= p.lo && v <= p.hi))
@@ -124,7 +130,8 @@ void Simulation::read_model(Options& opt, const std::string& base_dir) {
   D_.assign(ns, 0.0);
   floor_.assign(ns, clamp ? 0.0 : -kInf);
   bool any_dirichlet = false;
-  for (int d = 0; d < spec_.dim; ++d) any_dirichlet |= spec_.bc[d] == Boundary::Dirichlet;
+  for (int d = 0; d < spec_.dim; ++d)
+    any_dirichlet |= spec_.bc[d] == Boundary::Dirichlet;
   dirichlet_.assign(any_dirichlet ? ns : 0, FaceValues{});
   u_.clear();
   work_.clear();
@@ -169,7 +176,7 @@ void Simulation::read_model(Options& opt, const std::string& base_dir) {
               for (PetscInt j = gb.s[1]; j < gb.s[1] + gb.m[1]; ++j)
                 for (PetscInt i = gb.s[0]; i < gb.s[0] + gb.m[0]; ++i) {
                   PetscInt c[3] = {i, j, k};
-                  if (c[d] != gb.s[d]) continue; // one entry per face position
+                  if (c[d] != gb.s[d]) continue;      // one entry per face position
                   for (int e = 0; e < spec_.dim; ++e) // periodic images share face values
                     if (spec_.bc[e] == Boundary::Periodic)
                       c[e] = (c[e] % spec_.n[e] + spec_.n[e]) % spec_.n[e];
@@ -177,7 +184,8 @@ void Simulation::read_model(Options& opt, const std::string& base_dir) {
                                  spec_.dim == 3 ? grid_->centre(2, c[2]) : 0.0};
                   x[d] = side == 0 ? 0.0 : spec_.L[d];
                   c[d] = side == 0 ? 0 : spec_.n[d] - 1;
-                  face[halo_->face_index(d, i, j, k)] = g.at_point(x[0], x[1], x[2], c[0], c[1], c[2]);
+                  face[halo_->face_index(d, i, j, k)] =
+                      g.at_point(x[0], x[1], x[2], c[0], c[1], c[2]);
                 }
           } catch (const UserError& e) {
             err = e.what();
@@ -188,8 +196,8 @@ void Simulation::read_model(Options& opt, const std::string& base_dir) {
     }
   }
   const ExplicitIntegrator::RowFn fn = model_->row_kernel(params_.any_field(), stencil_.nterms);
-  integrator_ = std::make_unique<ExplicitIntegrator>(*grid_, *halo_, fn, ns, stencil_, D_, floor_,
-                                                     params_, any_dirichlet ? &dirichlet_ : nullptr);
+  integrator_ = std::make_unique<ExplicitIntegrator>(
+      *grid_, *halo_, fn, ns, stencil_, D_, floor_, params_, any_dirichlet ? &dirichlet_ : nullptr);
   integrator_->update_ghosts(u_);
 }
 
@@ -206,26 +214,27 @@ void Simulation::read_time(Options& opt) {
     throw UserError("-dt " + format_double(dt_) +
                     ": exceeds the explicit diffusion stability bound dt <= " +
                     format_double(stable_dt_) + " (2/(D_max*rho(L)) for the " + stencil_.name +
-                    " stencil, D_max = " +
-                    format_double(*std::max_element(D_.begin(), D_.end())) +
+                    " stencil, D_max = " + format_double(*std::max_element(D_.begin(), D_.end())) +
                     "); use a smaller -dt or -force_dt");
-  steps_ = opt.integer("steps", 1000, 0, std::numeric_limits<PetscInt>::max(),
-                       "number of time steps");
+  steps_ =
+      opt.integer("steps", 1000, 0, std::numeric_limits<PetscInt>::max(), "number of time steps");
 }
 
 void Simulation::read_output(Options& opt) {
-  out_.dir = opt.string("output_dir", "morphogen_out", "directory for images and options_used.yaml");
+  out_.dir =
+      opt.string("output_dir", "morphogen_out", "directory for images and options_used.yaml");
   if (out_.dir.empty()) throw UserError("-output_dir: must not be empty");
   out_.png_every = opt.integer("png_every", 0, 0, std::numeric_limits<PetscInt>::max(),
                                "write PNG images every N steps (0: only at the end)");
-  const auto names = opt.list("png_species", species_, 0, 16,
-                              "species written as PNG images (default: all)");
+  const auto names =
+      opt.list("png_species", species_, 0, 16, "species written as PNG images (default: all)");
   out_.png_species.clear();
   for (const auto& n : names) {
     auto it = std::find(species_.begin(), species_.end(), n);
     if (it == species_.end()) {
       std::string all;
-      for (auto& s : species_) all += (all.empty() ? "" : ", ") + s;
+      for (auto& s : species_)
+        all += (all.empty() ? "" : ", ") + s;
       throw UserError("-png_species " + n + ": no such species in model " + model_->name +
                       ", allowed " + all);
     }

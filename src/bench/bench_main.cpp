@@ -26,7 +26,8 @@ double stream_triad(MPI_Comm comm, size_t n, int reps) {
     double* __restrict__ pa = a.data();
     const double* __restrict__ pb = b.data();
     const double* __restrict__ pc = c.data();
-    for (size_t i = 0; i < n; ++i) pa[i] = pb[i] + s * pc[i];
+    for (size_t i = 0; i < n; ++i)
+      pa[i] = pb[i] + s * pc[i];
     double dt = MPI_Wtime() - t0, dtmax = 0;
     MPI_Allreduce(&dt, &dtmax, 1, MPI_DOUBLE, MPI_MAX, comm);
     best = std::min(best, dtmax);
@@ -42,21 +43,25 @@ struct Result {
   double cups = 0, halo_s = 0, g2l_s = 0;
 };
 
-Result bench_explicit(MPI_Comm comm, const std::string& n, int steps) {
-  PetscOptionsClear(nullptr);
+Result bench_explicit(MPI_Comm comm, Options& opt, const std::string& n, int steps) {
   const std::pair<const char*, const char*> opts[] = {
-      {"-model", "gray_scott"}, {"-grid_n", n.c_str()}, {"-grid_L", "2.5"},
-      {"-init_a", "0.25*square(1.25,1.25,0.1) +- 1%"}, {"-init_b", "1 - 0.5*square(1.25,1.25,0.1)"}};
-  for (auto& [k, v] : opts) MG_PETSC(PetscOptionsSetValue(nullptr, k, v));
-  Options opt(comm);
+      {"-model", "gray_scott"},
+      {"-grid_n", n.c_str()},
+      {"-grid_L", "2.5"},
+      {"-init_a", "0.25*square(1.25,1.25,0.1) +- 1%"},
+      {"-init_b", "1 - 0.5*square(1.25,1.25,0.1)"}};
+  for (auto& [k, v] : opts)
+    MG_PETSC(PetscOptionsSetValue(nullptr, k, v));
   Simulation sim(comm, opt, "");
-  for (int i = 0; i < 5; ++i) sim.step(); // warm up
+  for (int i = 0; i < 5; ++i)
+    sim.step(); // warm up
   Result r;
   double best = 1e30;
   for (int rep = 0; rep < 3; ++rep) {
     MPI_Barrier(comm);
     const double t0 = MPI_Wtime();
-    for (int i = 0; i < steps; ++i) sim.step();
+    for (int i = 0; i < steps; ++i)
+      sim.step();
     MPI_Barrier(comm);
     best = std::min(best, MPI_Wtime() - t0);
   }
@@ -65,7 +70,8 @@ Result bench_explicit(MPI_Comm comm, const std::string& n, int steps) {
   const int reps = 50;
   MPI_Barrier(comm);
   double t0 = MPI_Wtime();
-  for (int i = 0; i < reps; ++i) sim.refresh_ghosts();
+  for (int i = 0; i < reps; ++i)
+    sim.refresh_ghosts();
   r.halo_s = (MPI_Wtime() - t0) / reps / 2;
   VecH g = sim.grid().create_global();
   MPI_Barrier(comm);
@@ -84,20 +90,21 @@ int run(MPI_Comm comm) {
   Options opt(comm);
   const PetscInt steps2 = opt.integer("bench_steps_2d", 200, 1, 1000000, "timed steps at 1024^2");
   const PetscInt steps3 = opt.integer("bench_steps_3d", 50, 1, 1000000, "timed steps at 128^3");
-  const PetscInt mb = opt.integer("bench_stream_mb", 256, 8, 65536, "STREAM array size per rank, MiB");
-  opt.check_unused();
+  const PetscInt mb =
+      opt.integer("bench_stream_mb", 256, 8, 65536, "STREAM array size per rank, MiB");
   const double bw = stream_triad(comm, static_cast<size_t>(mb) * 1024 * 1024 / 8, 10);
   const double roof = bw / 32.0;
   PetscPrintf(comm, "ranks=%d\nstream_triad_GBps=%.2f\nroofline_cell_updates_per_s=%.4e\n", size,
               bw / 1e9, roof);
-  const Result r2 = bench_explicit(comm, "1024,1024", static_cast<int>(steps2));
+  const Result r2 = bench_explicit(comm, opt, "1024,1024", static_cast<int>(steps2));
+  opt.check_unused();
   PetscPrintf(comm,
               "explicit_2d grid=1024x1024 model=gray_scott bytes_per_update=32 "
               "cell_updates_per_s=%.4e fraction=%.3f\n",
               r2.cups, r2.cups / roof);
   PetscPrintf(comm, "halo_2d halo_only_update_ms=%.4f dm_global_to_local_ms=%.4f\n",
               1e3 * r2.halo_s, 1e3 * r2.g2l_s);
-  const Result r3 = bench_explicit(comm, "128,128,128", static_cast<int>(steps3));
+  const Result r3 = bench_explicit(comm, opt, "128,128,128", static_cast<int>(steps3));
   PetscPrintf(comm,
               "explicit_3d grid=128x128x128 model=gray_scott bytes_per_update=32 "
               "cell_updates_per_s=%.4e fraction=%.3f\n",

@@ -27,7 +27,8 @@ std::string format_double(double v) {
 
 size_t edit_distance(const std::string& a, const std::string& b) {
   std::vector<size_t> prev(b.size() + 1), cur(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) prev[j] = j;
+  for (size_t j = 0; j <= b.size(); ++j)
+    prev[j] = j;
   for (size_t i = 1; i <= a.size(); ++i) {
     cur[0] = i;
     for (size_t j = 1; j <= b.size(); ++j) {
@@ -80,7 +81,8 @@ double Options::parse_real(const std::string& name, const std::string& text) {
   errno = 0;
   char* end = nullptr;
   const double v = std::strtod(text.c_str(), &end);
-  while (end && *end == ' ') ++end;
+  while (end && *end == ' ')
+    ++end;
   if (text.empty() || !end || *end != '\0' || errno == ERANGE || std::isnan(v))
     throw UserError("-" + name + " " + text + ": not a number");
   return v;
@@ -90,7 +92,8 @@ PetscInt Options::parse_int(const std::string& name, const std::string& text) {
   errno = 0;
   char* end = nullptr;
   const long long v = std::strtoll(text.c_str(), &end, 10);
-  while (end && *end == ' ') ++end;
+  while (end && *end == ' ')
+    ++end;
   if (text.empty() || !end || *end != '\0' || errno == ERANGE)
     throw UserError("-" + name + " " + text + ": not an integer");
   return static_cast<PetscInt>(v);
@@ -114,9 +117,8 @@ PetscInt Options::integer(const std::string& name, PetscInt def, PetscInt lo, Pe
   auto s = get(name, h);
   const PetscInt v = s ? parse_int(name, *s) : def;
   if (v < lo || v > hi)
-    throw UserError("-" + name + " " + (s ? *s : std::to_string(v)) +
-                    ": out of range, allowed [" + std::to_string(lo) + ", " + std::to_string(hi) +
-                    "]");
+    throw UserError("-" + name + " " + (s ? *s : std::to_string(v)) + ": out of range, allowed [" +
+                    std::to_string(lo) + ", " + std::to_string(hi) + "]");
   record(name, std::to_string(v), h);
   return v;
 }
@@ -128,9 +130,12 @@ bool Options::flag(const std::string& name, bool def, const std::string& help) {
   if (s) {
     std::string t = *s;
     std::transform(t.begin(), t.end(), t.begin(), ::tolower);
-    if (t.empty() || t == "true" || t == "1" || t == "yes" || t == "on") v = true;
-    else if (t == "false" || t == "0" || t == "no" || t == "off") v = false;
-    else throw UserError("-" + name + " " + *s + ": not a boolean, allowed true or false");
+    if (t.empty() || t == "true" || t == "1" || t == "yes" || t == "on")
+      v = true;
+    else if (t == "false" || t == "0" || t == "no" || t == "off")
+      v = false;
+    else
+      throw UserError("-" + name + " " + *s + ": not a boolean, allowed true or false");
   }
   record(name, v ? "true" : "false", h);
   return v;
@@ -147,7 +152,8 @@ std::string Options::string(const std::string& name, const std::string& def,
 std::string Options::choice(const std::string& name, const std::string& def,
                             const std::vector<std::string>& allowed, const std::string& help) {
   std::string all;
-  for (auto& a : allowed) all += (all.empty() ? "" : ", ") + a;
+  for (auto& a : allowed)
+    all += (all.empty() ? "" : ", ") + a;
   const std::string h = help + " (" + all + ")";
   auto s = get(name, h);
   const std::string v = s ? *s : def;
@@ -163,9 +169,9 @@ std::string Options::choice(const std::string& name, const std::string& def,
   return v;
 }
 
-std::vector<std::string> Options::list(const std::string& name,
-                                       const std::vector<std::string>& def, size_t min_count,
-                                       size_t max_count, const std::string& help) {
+std::vector<std::string> Options::list(const std::string& name, const std::vector<std::string>& def,
+                                       size_t min_count, size_t max_count,
+                                       const std::string& help) {
   auto s = get(name, help);
   std::vector<std::string> v;
   if (s) {
@@ -180,12 +186,13 @@ std::vector<std::string> Options::list(const std::string& name,
   }
   if (v.size() < min_count || v.size() > max_count)
     throw UserError("-" + name + " " + (s ? *s : "") + ": expected " +
-                    (min_count == max_count ? std::to_string(min_count)
-                                            : std::to_string(min_count) + " to " +
-                                                  std::to_string(max_count)) +
+                    (min_count == max_count
+                         ? std::to_string(min_count)
+                         : std::to_string(min_count) + " to " + std::to_string(max_count)) +
                     " comma-separated values, got " + std::to_string(v.size()));
   std::string joined;
-  for (auto& x : v) joined += (joined.empty() ? "" : ",") + x;
+  for (auto& x : v)
+    joined += (joined.empty() ? "" : ",") + x;
   record(name, joined, help);
   return v;
 }
@@ -204,11 +211,17 @@ void Options::check_unused() const {
     auto consider = [&](const std::string& cand) {
       if (size_t d = edit_distance(name, cand); d < bd) bd = d, best = cand;
     };
-    for (auto& r : records_) consider(r.name);
-    for (auto& k : known_) consider(k);
-    msg = "-" + name + (values[i] ? " " + std::string(values[i]) : std::string()) +
-          ": unknown option (nothing read it)" +
-          (best.empty() ? "; see -help" : "; did you mean -" + best + "?");
+    for (auto& r : records_)
+      consider(r.name);
+    for (auto& k : known_)
+      consider(k);
+    msg = "-" + name;
+    if (values[i]) msg.append(" ").append(values[i]);
+    msg.append(": unknown option (nothing read it)");
+    if (best.empty())
+      msg.append("; see -help");
+    else
+      msg.append("; did you mean -").append(best).append("?");
   }
   MG_PETSC(PetscOptionsLeftRestore(nullptr, &n, &names, &values));
   if (!msg.empty()) throw UserError(msg);

@@ -71,7 +71,8 @@ struct ValueSpecFunctions {
     for (long m = 0; m < count; ++m) {
       double d2 = 0;
       for (int d = 0; d < v.grid_.dim; ++d) {
-        const double c = rng::uniform(s, stream, static_cast<std::uint64_t>(3 * m + d)) * v.grid_.L[d];
+        const double c =
+            rng::uniform(s, stream, static_cast<std::uint64_t>(3 * m + d)) * v.grid_.L[d];
         const double e = dx(v, d, c);
         d2 += e * e;
       }
@@ -103,7 +104,8 @@ ValueSpec::ValueSpec(const std::string& key, const std::string& text, const Grid
   std::string expr = text;
   if (const size_t pm = find_plus_minus(text); pm != std::string::npos) {
     expr = text.substr(0, pm);
-    static const std::regex amount_re(R"(^\s*([0-9.eE+\-]+)\s*(%?)\s*(uniform|gauss|gaussian)?\s*$)");
+    static const std::regex amount_re(
+        R"(^\s*([0-9.eE+\-]+)\s*(%?)\s*(uniform|gauss|gaussian)?\s*$)");
     std::smatch m;
     const std::string rest = text.substr(pm + 2);
     if (!std::regex_match(rest, m, amount_re))
@@ -195,9 +197,8 @@ double ValueSpec::eval_expr() {
   }
   if (perturb_ != Perturb::None) {
     const double a = percent_ ? amount_ * 0.01 * std::abs(v) : amount_;
-    v += perturb_ == Perturb::Uniform
-             ? a * (2.0 * rng::uniform(seed_, stream_, cell_) - 1.0)
-             : a * rng::gaussian(seed_, stream_, cell_);
+    v += perturb_ == Perturb::Uniform ? a * (2.0 * rng::uniform(seed_, stream_, cell_) - 1.0)
+                                      : a * rng::gaussian(seed_, stream_, cell_);
   }
   if (!std::isfinite(v))
     throw UserError("-" + key_ + " " + text_ + ": evaluates to " + format_double(v) + where());

@@ -52,8 +52,7 @@ public:
   // Value at global cell (i, j, k) (cell centre), at time t.
   double at_cell(PetscInt i, PetscInt j, PetscInt k, double t = 0.0);
   // Value at an arbitrary point (x, y, z); (i, j, k) name the cell whose deviates are used.
-  double at_point(double x, double y, double z, PetscInt i, PetscInt j, PetscInt k,
-                  double t = 0.0);
+  double at_point(double x, double y, double z, PetscInt i, PetscInt j, PetscInt k, double t = 0.0);
 
 private:
   friend struct ValueSpecFunctions;

@@ -40,13 +40,15 @@ Grid::Grid(MPI_Comm comm, const GridSpec& spec) : spec_(spec) {
   MG_PETSC(DMDASetUniformCoordinates(dm_, 0.5 * spec_.h(0), spec_.L[0] - 0.5 * spec_.h(0),
                                      0.5 * spec_.h(1), spec_.L[1] - 0.5 * spec_.h(1),
                                      0.5 * spec_.h(2), spec_.L[2] - 0.5 * spec_.h(2)));
-  MG_PETSC(DMDAGetCorners(dm_, &owned_.s[0], &owned_.s[1], &owned_.s[2], &owned_.m[0],
-                          &owned_.m[1], &owned_.m[2]));
-  MG_PETSC(DMDAGetGhostCorners(dm_, &ghosted_.s[0], &ghosted_.s[1], &ghosted_.s[2],
-                               &ghosted_.m[0], &ghosted_.m[1], &ghosted_.m[2]));
+  MG_PETSC(DMDAGetCorners(dm_, &owned_.s[0], &owned_.s[1], &owned_.s[2], &owned_.m[0], &owned_.m[1],
+                          &owned_.m[2]));
+  MG_PETSC(DMDAGetGhostCorners(dm_, &ghosted_.s[0], &ghosted_.s[1], &ghosted_.s[2], &ghosted_.m[0],
+                               &ghosted_.m[1], &ghosted_.m[2]));
 }
 
-MPI_Comm Grid::comm() const { return PetscObjectComm(reinterpret_cast<PetscObject>(dm_.get())); }
+MPI_Comm Grid::comm() const {
+  return PetscObjectComm(reinterpret_cast<PetscObject>(dm_.get()));
+}
 
 VecH Grid::create_local() const {
   VecH v;

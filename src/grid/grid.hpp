@@ -52,7 +52,8 @@ public:
 
   // Index of global cell (i,j,k) in this rank's ghosted local array.
   PetscInt local_index(PetscInt i, PetscInt j, PetscInt k) const {
-    return (i - ghosted_.s[0]) + ghosted_.m[0] * ((j - ghosted_.s[1]) + ghosted_.m[1] * (k - ghosted_.s[2]));
+    return (i - ghosted_.s[0]) +
+           ghosted_.m[0] * ((j - ghosted_.s[1]) + ghosted_.m[1] * (k - ghosted_.s[2]));
   }
   // Index of global cell (i,j,k) in this rank's owned (global-Vec) array.
   PetscInt owned_index(PetscInt i, PetscInt j, PetscInt k) const {
@@ -62,7 +63,8 @@ public:
   std::uint64_t natural_index(PetscInt i, PetscInt j, PetscInt k) const {
     return static_cast<std::uint64_t>(i) +
            static_cast<std::uint64_t>(spec_.n[0]) *
-               (static_cast<std::uint64_t>(j) + static_cast<std::uint64_t>(spec_.n[1]) * static_cast<std::uint64_t>(k));
+               (static_cast<std::uint64_t>(j) +
+                static_cast<std::uint64_t>(spec_.n[1]) * static_cast<std::uint64_t>(k));
   }
   double centre(int d, PetscInt i) const { return (static_cast<double>(i) + 0.5) * spec_.h(d); }
 

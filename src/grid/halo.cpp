@@ -12,7 +12,8 @@ struct AxisLayout {
   std::vector<PetscInt> count;
   PetscInt owner(PetscInt i) const {
     PetscInt p = 0;
-    while (p + 1 < static_cast<PetscInt>(start.size()) && i >= start[p + 1]) ++p;
+    while (p + 1 < static_cast<PetscInt>(start.size()) && i >= start[p + 1])
+      ++p;
     return p;
   }
 };
@@ -49,8 +50,10 @@ Halo::Halo(const Grid& grid) : grid_(grid) {
         bool inside = true;
         for (int d = 0; d < 3 && inside; ++d) {
           if (c[d] >= 0 && c[d] < g.n[d]) continue;
-          if (g.bc[d] != Boundary::Periodic) inside = false;
-          else c[d] = (c[d] % g.n[d] + g.n[d]) % g.n[d];
+          if (g.bc[d] != Boundary::Periodic)
+            inside = false;
+          else
+            c[d] = (c[d] % g.n[d] + g.n[d]) % g.n[d];
         }
         if (!inside) continue;
         PetscInt p[3], gs[3], gm[3];
@@ -76,7 +79,9 @@ void Halo::begin(double* a) const {
   MG_PETSC(PetscSFBcastBegin(sf_, MPIU_SCALAR, a, a, MPI_REPLACE));
 }
 
-void Halo::end(double* a) const { MG_PETSC(PetscSFBcastEnd(sf_, MPIU_SCALAR, a, a, MPI_REPLACE)); }
+void Halo::end(double* a) const {
+  MG_PETSC(PetscSFBcastEnd(sf_, MPIU_SCALAR, a, a, MPI_REPLACE));
+}
 
 PetscInt Halo::face_size(int d) const {
   const Box& gb = grid_.ghosted();
@@ -106,7 +111,8 @@ void Halo::fill_boundaries(double* u, const FaceValues* dirichlet) const {
         if (ghost < gb.s[d] || ghost >= gb.s[d] + gb.m[d]) continue;
         const std::vector<double>* vals = dir ? &dirichlet->face[2 * d + side] : nullptr;
         PetscInt lo[3] = {gb.s[0], gb.s[1], gb.s[2]}, hi[3];
-        for (int e = 0; e < 3; ++e) hi[e] = gb.s[e] + gb.m[e];
+        for (int e = 0; e < 3; ++e)
+          hi[e] = gb.s[e] + gb.m[e];
         lo[d] = ghost;
         hi[d] = ghost + 1;
         for (PetscInt k = lo[2]; k < hi[2]; ++k)

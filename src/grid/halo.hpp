@@ -38,7 +38,8 @@ public:
     fill_boundaries(a, dirichlet);
   }
 
-  // Position (in the face array of axis d) of ghosted-box cell (i,j,k): the other two axes' offsets.
+  // Position (in the face array of axis d) of ghosted-box cell (i,j,k): the other two axes'
+  // offsets.
   PetscInt face_index(int d, PetscInt i, PetscInt j, PetscInt k) const;
   PetscInt face_size(int d) const;
 

@@ -9,30 +9,33 @@ ExplicitIntegrator::ExplicitIntegrator(const Grid& grid, const Halo& halo, RowFn
                                        int nspecies, const Stencil& stencil, std::vector<double> D,
                                        std::vector<double> floor, const ParamSet& params,
                                        const std::vector<FaceValues>* dirichlet)
-    : grid_(grid), halo_(halo), row_fn_(row_fn), ns_(nspecies), stencil_(stencil),
-      D_(std::move(D)), floor_(std::move(floor)), params_(params), dirichlet_(dirichlet) {
+    : grid_(grid), halo_(halo), row_fn_(row_fn), ns_(nspecies), stencil_(stencil), D_(std::move(D)),
+      floor_(std::move(floor)), params_(params), dirichlet_(dirichlet) {
   if (params_.any_field())
     for (size_t q = 0; q < params_.scalar.size(); ++q)
-      const_rows_.emplace_back(params_.field[q].get() ? 0 : grid.owned().m[0],
-                               params_.scalar[q]);
+      const_rows_.emplace_back(params_.field[q].get() ? 0 : grid.owned().m[0], params_.scalar[q]);
 }
 
 double ExplicitIntegrator::stable_dt(const Stencil& stencil, const std::vector<double>& D) {
   double dmax = 0;
-  for (double d : D) dmax = std::max(dmax, d);
+  for (double d : D)
+    dmax = std::max(dmax, d);
   const double rho = stencil.spectral_radius();
   return dmax > 0 && rho > 0 ? 2.0 / (dmax * rho) : std::numeric_limits<double>::infinity();
 }
 
 void ExplicitIntegrator::update_ghosts(std::vector<VecH>& u) const {
   std::vector<PetscScalar*> a(ns_);
-  for (int s = 0; s < ns_; ++s) MG_PETSC(VecGetArray(u[s], &a[s]));
-  for (int s = 0; s < ns_; ++s) halo_.begin(a[s]);
+  for (int s = 0; s < ns_; ++s)
+    MG_PETSC(VecGetArray(u[s], &a[s]));
+  for (int s = 0; s < ns_; ++s)
+    halo_.begin(a[s]);
   for (int s = 0; s < ns_; ++s) {
     halo_.end(a[s]);
     halo_.fill_boundaries(a[s], dirichlet_ ? &(*dirichlet_)[s] : nullptr);
   }
-  for (int s = 0; s < ns_; ++s) MG_PETSC(VecRestoreArray(u[s], &a[s]));
+  for (int s = 0; s < ns_; ++s)
+    MG_PETSC(VecRestoreArray(u[s], &a[s]));
 }
 
 void ExplicitIntegrator::step(std::vector<VecH>& u, std::vector<VecH>& work, double dt) const {
@@ -72,12 +75,14 @@ void ExplicitIntegrator::step(std::vector<VecH>& u, std::vector<VecH>& work, dou
     for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j) {
       const PetscInt c = grid_.local_index(ob.s[0], j, k);
       for (int s = 0; s < ns_; ++s) {
-        for (int t = 0; t < nt; ++t) src[s * nt + t] = in[s] + c + delta[t];
+        for (int t = 0; t < nt; ++t)
+          src[s * nt + t] = in[s] + c + delta[t];
         dst[s] = out[s] + c;
       }
       if (field_mode) {
         const PetscInt o = grid_.owned_index(ob.s[0], j, k);
-        for (int q = 0; q < np; ++q) prow[q] = pf[q] ? pf[q] + o : const_rows_[q].data();
+        for (int q = 0; q < np; ++q)
+          prow[q] = pf[q] ? pf[q] + o : const_rows_[q].data();
       }
       row_fn_(row);
     }

@@ -41,7 +41,8 @@ std::vector<double> gather_xy_slice(const Grid& grid, const double* ghosted, Pet
     const int* r = &rects[4 * p];
     const double* src = all.data() + displs[p];
     for (int j = 0; j < r[3]; ++j)
-      for (int i = 0; i < r[2]; ++i) out[(r[0] + i) + nx * (r[1] + j)] = src[i + r[2] * j];
+      for (int i = 0; i < r[2]; ++i)
+        out[(r[0] + i) + nx * (r[1] + j)] = src[i + r[2] * j];
   }
   return out;
 }

@@ -6,7 +6,7 @@
 // excitation threshold. The appendix writes the threshold as (V + b) / a; V is B.
 // The rest state A* = B* = 0 is a homogeneous steady state for all parameters (a, eps > 0);
 // it is excitable, so waves need a supra-threshold seed (a broken plane wave gives a spiral).
-// Defaults a = 0.75, b = 0.02, eps = 0.02 give rigidly rotating spirals.
+// Defaults a = 0.75, b = 0.02, eps = 0.02: a broken plane wave curls into a steady spiral.
 //
 // Barkley's "turbulent" variant (same appendix) replaces the recovery kinetics by
 //   dB/dt = A^3 - B,

@@ -8,12 +8,13 @@
 // steady_state returns the unique real root where there is one (a1 <= 1 always, or |a0|
 // large); where there are three (bistable medium) it returns the middle one, the unstable
 // state between the two stable branches, from which a noisy start separates into domains.
-// Defaults (our choice; the paper gives no values): eps = 0.05, a0 = 0, a1 = 2, D_A = 1,
+// Defaults (our choice; the paper gives no values): eps = 0.1, a0 = 0, a1 = 2, D_A = 1,
 // D_B = 2. This is the bistable regime with three states A* = -1/sqrt 2, 0, 1/sqrt 2; the
-// middle state (0, 0) is a saddle, and from it a noisy start forms a stationary labyrinth of
-// A = +-0.7 domains with a period of about 25 grid units at unit spacing. Smaller eps makes
-// the fronts travel (spirals); a1 < 1 with the rest state on the left branch (e.g. a1 = 0.5,
-// a0 = -0.5) gives an excitable medium with travelling pulses.
+// middle state (0, 0) is a saddle, and from it a noisy start forms a labyrinth of A = +-0.9
+// domains with a period of about 25 grid units at unit spacing, which then only rearranges
+// slowly (checked for eps = 0.05-0.2 with D_B = 2-4; for eps <= 0.02 one phase takes over).
+// With a1 < 1 and the rest state on the left branch (e.g. a1 = 0.5, a0 = -0.5, D_B = 0) the
+// medium is excitable instead, and a seeded pulse travels (about 0.9 grid units per time).
 #pragma once
 
 #include <cmath>
@@ -35,7 +36,7 @@ struct FitzHughNagumo {
       {"B", 2.0, 0.0, "slow inhibitor (signed)"},
   }};
   static constexpr std::array<ParamInfo, 3> params{{
-      {"eps", 0.05, 0.0, 1e3, "time-scale ratio of B to A"},
+      {"eps", 0.1, 0.0, 1e3, "time-scale ratio of B to A"},
       {"a0", 0.0, -1e3, 1e3, "offset of the B nullcline (asymmetry between A = +-1)"},
       {"a1", 2.0, 0.0, 1e3, "B self-decay; a1 > 1 can make the medium bistable"},
   }};

@@ -14,7 +14,8 @@
 //   static constexpr bool clamp_default;     // clamp negative concentrations to 0 by default
 //   static void rates(const double* u, const double* p, double* r);     // r_s = R_s(u; p)
 //   static void jacobian(const double* u, const double* p, double* J);  // J[s*N+q] = dR_s/du_q
-//   static bool steady_state(const double* p, double* u);  // homogeneous u* with R(u*)=0; false if none
+//   static bool steady_state(const double* p, double* u);  // homogeneous u* with R(u*)=0; false if
+//   none
 #pragma once
 
 #include <array>

@@ -7,7 +7,8 @@ bool make_stencil(const std::string& name, int dim, const double* h, Stencil& s)
   r.name = name;
   if ((name == "5pt" && dim == 2) || (name == "7pt" && dim == 3)) {
     double centre = 0;
-    for (int d = 0; d < dim; ++d) centre -= 2.0 / (h[d] * h[d]);
+    for (int d = 0; d < dim; ++d)
+      centre -= 2.0 / (h[d] * h[d]);
     r.add(0, 0, 0, centre);
     for (int d = 0; d < dim; ++d) {
       const double w = 1.0 / (h[d] * h[d]);

@@ -46,7 +46,8 @@ struct Stencil {
   // Apply to a function sampled at offsets (for tests): sum_t w_t f(off_t).
   template <class F> double apply(F&& f) const {
     double s = 0;
-    for (int t = 0; t < nterms; ++t) s += w[t] * f(off[t][0], off[t][1], off[t][2]);
+    for (int t = 0; t < nterms; ++t)
+      s += w[t] * f(off[t][0], off[t][1], off[t][2]);
     return s;
   }
 };

@@ -115,7 +115,8 @@ TEST(ValueSpec, Shapes) {
   ValueSpec sp("k", "spots(20, 0.2, 3)", spec(2), 1);
   int inside = 0;
   for (int j = 0; j < 29; ++j)
-    for (int i = 0; i < 37; ++i) inside += sp.at_cell(i, j, 0) > 0.5;
+    for (int i = 0; i < 37; ++i)
+      inside += sp.at_cell(i, j, 0) > 0.5;
   EXPECT_GT(inside, 20);
   EXPECT_LT(inside, 37 * 29);
 }
@@ -159,8 +160,9 @@ TEST(ValueSpec, ErrorsNameTheKey) {
   EXPECT_NE(error_of("init_a", "sqrt(-1)").find("-init_a"), std::string::npos);
   EXPECT_NE(error_of("init_a", "4 +- x%").find("bad perturbation"), std::string::npos);
   EXPECT_NE(error_of("init_a", "").find("empty"), std::string::npos);
-  EXPECT_NE(error_of("params_alpha", "png(\"/nonexistent/p.png\", 0, 1)").find("/nonexistent/p.png"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of("params_alpha", "png(\"/nonexistent/p.png\", 0, 1)").find("/nonexistent/p.png"),
+      std::string::npos);
 }
 
 TEST(FieldFill, RangeViolationIsCollective) {

@@ -13,7 +13,9 @@ using morphogen::testing::all_ranks;
 
 namespace {
 
-double f(PetscInt i, PetscInt j, PetscInt k) { return 1.0 + i + 1000.0 * j + 1e6 * k; }
+double f(PetscInt i, PetscInt j, PetscInt k) {
+  return 1.0 + i + 1000.0 * j + 1e6 * k;
+}
 
 // Dirichlet value on face (d, side) at the (periodically wrapped) position of the other axes.
 double g_value(int d, int side, const PetscInt* c) {
@@ -31,7 +33,8 @@ bool check(const GridSpec& spec) {
   const Box& gb = grid.ghosted();
   for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
     for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j)
-      for (PetscInt i = ob.s[0]; i < ob.s[0] + ob.m[0]; ++i) a[grid.local_index(i, j, k)] = f(i, j, k);
+      for (PetscInt i = ob.s[0]; i < ob.s[0] + ob.m[0]; ++i)
+        a[grid.local_index(i, j, k)] = f(i, j, k);
   auto wrap = [&](PetscInt* c) {
     for (int d = 0; d < 3; ++d)
       if (s.bc[d] == Boundary::Periodic) c[d] = (c[d] % s.n[d] + s.n[d]) % s.n[d];
@@ -52,7 +55,8 @@ bool check(const GridSpec& spec) {
   halo.update(a, &fv);
   // Expected value of any ghosted-box position: wrap periodic axes; the highest non-periodic
   // axis that is out of range decides (fill order x, y, z).
-  std::function<double(PetscInt, PetscInt, PetscInt)> expect = [&](PetscInt i, PetscInt j, PetscInt k) {
+  std::function<double(PetscInt, PetscInt, PetscInt)> expect = [&](PetscInt i, PetscInt j,
+                                                                   PetscInt k) {
     PetscInt c[3] = {i, j, k};
     wrap(c);
     int dd = -1;
@@ -74,7 +78,9 @@ bool check(const GridSpec& spec) {
       for (PetscInt i = gb.s[0]; i < gb.s[0] + gb.m[0]; ++i) {
         const double got = a[grid.local_index(i, j, k)], want = expect(i, j, k);
         if (got != want) {
-          if (ok) ADD_FAILURE() << "ghost (" << i << "," << j << "," << k << ") = " << got << ", expected " << want;
+          if (ok)
+            ADD_FAILURE() << "ghost (" << i << "," << j << "," << k << ") = " << got
+                          << ", expected " << want;
           ok = false;
         }
       }
@@ -104,15 +110,23 @@ constexpr Boundary P = Boundary::Periodic, N = Boundary::Neumann, D = Boundary::
 
 } // namespace
 
-TEST(Halo, Periodic2D) { EXPECT_TRUE(check(spec2(P, P))); }
-TEST(Halo, Neumann2D) { EXPECT_TRUE(check(spec2(N, N))); }
-TEST(Halo, Dirichlet2D) { EXPECT_TRUE(check(spec2(D, D))); }
+TEST(Halo, Periodic2D) {
+  EXPECT_TRUE(check(spec2(P, P)));
+}
+TEST(Halo, Neumann2D) {
+  EXPECT_TRUE(check(spec2(N, N)));
+}
+TEST(Halo, Dirichlet2D) {
+  EXPECT_TRUE(check(spec2(D, D)));
+}
 TEST(Halo, Mixed2D) {
   EXPECT_TRUE(check(spec2(P, N)));
   EXPECT_TRUE(check(spec2(D, P)));
   EXPECT_TRUE(check(spec2(N, D)));
 }
-TEST(Halo, Periodic3D) { EXPECT_TRUE(check(spec3(P, P, P))); }
+TEST(Halo, Periodic3D) {
+  EXPECT_TRUE(check(spec3(P, P, P)));
+}
 TEST(Halo, Mixed3D) {
   EXPECT_TRUE(check(spec3(N, D, P)));
   EXPECT_TRUE(check(spec3(D, D, D)));

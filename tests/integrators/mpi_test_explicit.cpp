@@ -18,9 +18,11 @@ namespace {
 
 std::vector<std::vector<double>> run_and_gather(MPI_Comm comm, const OptionList& opts, int steps) {
   auto sim = make_sim(comm, opts);
-  for (int n = 0; n < steps; ++n) sim->step();
+  for (int n = 0; n < steps; ++n)
+    sim->step();
   std::vector<std::vector<double>> out;
-  for (auto& v : sim->state()) out.push_back(gather_all(sim->grid(), v));
+  for (auto& v : sim->state())
+    out.push_back(gather_all(sim->grid(), v));
   return out;
 }
 
@@ -34,13 +36,16 @@ bool bitwise_equal_on_one_and_world(const OptionList& opts, int steps) {
     EXPECT_EQ(world.size(), self.size());
     for (size_t s = 0; s < world.size(); ++s) {
       EXPECT_EQ(world[s].size(), self[s].size());
-      const bool same = world[s].size() == self[s].size() &&
-                        std::memcmp(world[s].data(), self[s].data(), world[s].size() * sizeof(double)) == 0;
-      EXPECT_TRUE(same) << "species " << s << " differs between " << comm_size() << " ranks and 1 rank";
+      const bool same =
+          world[s].size() == self[s].size() &&
+          std::memcmp(world[s].data(), self[s].data(), world[s].size() * sizeof(double)) == 0;
+      EXPECT_TRUE(same) << "species " << s << " differs between " << comm_size()
+                        << " ranks and 1 rank";
       ok = ok && same;
       // The run must actually have evolved (not a trivially constant field).
       double mn = world[s][0], mx = world[s][0];
-      for (double v : world[s]) mn = std::min(mn, v), mx = std::max(mx, v);
+      for (double v : world[s])
+        mn = std::min(mn, v), mx = std::max(mx, v);
       EXPECT_GT(mx - mn, 1e-6);
     }
   }
@@ -94,7 +99,8 @@ TEST(ExplicitDiffusion, FourierModeDecaysAsDiscreteSymbol) {
                                          {"D_b", "0.01"},
                                          {"init_a", "1 + sin(2*pi*x/Lx)*cos(4*pi*y/Ly)"},
                                          {"dt", std::to_string(dt)}});
-  for (int n = 0; n < steps; ++n) sim->step();
+  for (int n = 0; n < steps; ++n)
+    sim->step();
   const double amp = std::pow(1 + sim->dt() * D * lambda, steps);
   ASSERT_LT(amp, 0.9); // the mode really decayed
   const auto a = gather_all(sim->grid(), sim->state()[0]);
@@ -102,7 +108,8 @@ TEST(ExplicitDiffusion, FourierModeDecaysAsDiscreteSymbol) {
   for (PetscInt j = 0; j < ny && !a.empty(); ++j)
     for (PetscInt i = 0; i < nx; ++i) {
       const double x = (i + 0.5) * hx, y = (j + 0.5) * hy;
-      err = std::max(err, std::abs(a[i + nx * j] - (1 + amp * std::sin(kx * x) * std::cos(ky * y))));
+      err =
+          std::max(err, std::abs(a[i + nx * j] - (1 + amp * std::sin(kx * x) * std::cos(ky * y))));
     }
   EXPECT_LT(max_over_ranks(err), 1e-12);
 }
@@ -117,7 +124,8 @@ TEST(ExplicitDiffusion, DirichletLinearSteadyState) {
                                          {"dirichlet_a", "1 + 2*x/Lx"},
                                          {"init_a", "0"},
                                          {"dt", "0.2"}});
-  for (int n = 0; n < 5000; ++n) sim->step();
+  for (int n = 0; n < 5000; ++n)
+    sim->step();
   const auto a = gather_all(sim->grid(), sim->state()[0]);
   double err = 0;
   for (size_t c = 0; c < a.size(); ++c) {
@@ -138,15 +146,22 @@ TEST(ExplicitDiffusion, NeumannAndPeriodicConserveMass) {
                                              {"init_a", "noise()"},
                                              {"dt", "0.5"}});
       const auto a0 = gather_all(sim->grid(), sim->state()[0]);
-      for (int n = 0; n < 500; ++n) sim->step();
+      for (int n = 0; n < 500; ++n)
+        sim->step();
       const auto a1 = gather_all(sim->grid(), sim->state()[0]);
       double m0 = 0, m1 = 0, var0 = 0, var1 = 0;
-      for (double v : a0) m0 += v;
-      for (double v : a1) m1 += v;
-      for (double v : a0) var0 += (v - m0 / a0.size()) * (v - m0 / a0.size());
-      for (double v : a1) var1 += (v - m1 / a1.size()) * (v - m1 / a1.size());
+      for (double v : a0)
+        m0 += v;
+      for (double v : a1)
+        m1 += v;
+      for (double v : a0)
+        var0 += (v - m0 / a0.size()) * (v - m0 / a0.size());
+      for (double v : a1)
+        var1 += (v - m1 / a1.size()) * (v - m1 / a1.size());
       const double rel = a0.empty() ? 0 : std::abs(m1 - m0) / m0;
       EXPECT_LT(max_over_ranks(rel), 1e-12) << stencil << " " << bc;
-      if (!a0.empty()) EXPECT_LT(var1, 0.1 * var0) << "diffusion did not smooth the noise";
+      if (!a0.empty()) {
+        EXPECT_LT(var1, 0.1 * var0) << "diffusion did not smooth the noise";
+      }
     }
 }

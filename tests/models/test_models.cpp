@@ -105,10 +105,10 @@ template <> struct Case<mm::Schnakenberg> {
 };
 
 template <> struct Case<mm::FitzHughNagumo> {
-  // eps = 0.05, a0 = 0, a1 = 2, (A, B) = (0.5, 0.1):
-  //   R_A = 0.5 - 0.125 - 0.1 = 0.275,  R_B = 0.05 (0.5 - 0.2 - 0) = 0.015
+  // eps = 0.1, a0 = 0, a1 = 2, (A, B) = (0.5, 0.1):
+  //   R_A = 0.5 - 0.125 - 0.1 = 0.275,  R_B = 0.1 (0.5 - 2*0.1 - 0) = 0.03
   static constexpr std::array<double, 2> u{0.5, 0.1};
-  static constexpr std::array<double, 2> r{0.275, 0.015};
+  static constexpr std::array<double, 2> r{0.275, 0.03};
   static constexpr std::array<std::array<double, 2>, 3> jac{{{0.0, 0.0}, {0.7, -0.3}, {-1.1, 0.4}}};
   static constexpr TuringKind turing = TuringKind::unstable_k0;
 };

@@ -12,7 +12,8 @@ namespace {
 // Evaluate stencil on f at a point (x0,y0,z0) with spacings h.
 template <class F> double lap_at(const Stencil& s, const double* h, F f) {
   const double x0 = 0.37, y0 = -1.3, z0 = 2.1;
-  return s.apply([&](int dx, int dy, int dz) { return f(x0 + dx * h[0], y0 + dy * h[1], z0 + dz * h[2]); });
+  return s.apply(
+      [&](int dx, int dy, int dz) { return f(x0 + dx * h[0], y0 + dy * h[1], z0 + dz * h[2]); });
 }
 
 } // namespace
@@ -23,7 +24,11 @@ TEST(Stencil, FivePointExactOnQuadratics) {
   ASSERT_TRUE(make_stencil("5pt", 2, h, s));
   EXPECT_EQ(s.nterms, 5);
   // lap(3x^2 - 2y^2 + 5xy + 7x - y + 4) = 6 - 4 = 2
-  EXPECT_NEAR(lap_at(s, h, [](double x, double y, double) { return 3 * x * x - 2 * y * y + 5 * x * y + 7 * x - y + 4; }), 2.0, 1e-11);
+  EXPECT_NEAR(lap_at(s, h,
+                     [](double x, double y, double) {
+                       return 3 * x * x - 2 * y * y + 5 * x * y + 7 * x - y + 4;
+                     }),
+              2.0, 1e-11);
   EXPECT_NEAR(lap_at(s, h, [](double, double, double) { return 1.0; }), 0.0, 1e-12);
 }
 
@@ -32,7 +37,9 @@ TEST(Stencil, NinePointIsotropicExactOnQuadratics) {
   Stencil s;
   ASSERT_TRUE(make_stencil("9pt", 2, h, s));
   EXPECT_EQ(s.nterms, 9);
-  EXPECT_NEAR(lap_at(s, h, [](double x, double y, double) { return x * x + y * y + 3 * x * y - x; }), 4.0, 1e-11);
+  EXPECT_NEAR(
+      lap_at(s, h, [](double x, double y, double) { return x * x + y * y + 3 * x * y - x; }), 4.0,
+      1e-11);
   // Garrity's operator: -u + 0.2 (edges) + 0.05 (corners) = 0.3 h^2 * lap.
   const double hh[3] = {1, 1, 1};
   ASSERT_TRUE(make_stencil("9pt", 2, hh, s));
@@ -49,7 +56,11 @@ TEST(Stencil, SevenPointExactOnQuadratics) {
   Stencil s;
   ASSERT_TRUE(make_stencil("7pt", 3, h, s));
   EXPECT_EQ(s.nterms, 7);
-  EXPECT_NEAR(lap_at(s, h, [](double x, double y, double z) { return x * x + 2 * y * y - 0.5 * z * z + x * y * z + y * z; }), 2 + 4 - 1, 1e-10);
+  EXPECT_NEAR(lap_at(s, h,
+                     [](double x, double y, double z) {
+                       return x * x + 2 * y * y - 0.5 * z * z + x * y * z + y * z;
+                     }),
+              2 + 4 - 1, 1e-10);
 }
 
 TEST(Stencil, UnknownOrWrongDimensionRefused) {
