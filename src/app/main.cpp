@@ -24,11 +24,13 @@ void print_models(MPI_Comm comm) {
   for (const auto& m : model_registry()) {
     PetscPrintf(comm, "  %-18s %s (%s)\n", m.name, m.doc, m.reference);
     for (int s = 0; s < m.nspecies; ++s)
-      PetscPrintf(comm, "      species %-6s D %-10g init %-8g %s\n", m.species[s].name,
-                  m.species[s].D, m.species[s].init, m.species[s].doc);
+      PetscPrintf(comm, "      species %-6s D %-10s init %-10s %s\n", m.species[s].name,
+                  format_double(m.species[s].D).c_str(), format_double(m.species[s].init).c_str(),
+                  m.species[s].doc);
     for (int q = 0; q < m.nparams; ++q)
-      PetscPrintf(comm, "      param   %-6s default %-10g range [%g, %g]  %s\n", m.params[q].name,
-                  m.params[q].def, m.params[q].lo, m.params[q].hi, m.params[q].doc);
+      PetscPrintf(comm, "      param   %-6s default %-10s range [%s, %s]  %s\n", m.params[q].name,
+                  format_double(m.params[q].def).c_str(), format_double(m.params[q].lo).c_str(),
+                  format_double(m.params[q].hi).c_str(), m.params[q].doc);
   }
 }
 
@@ -75,8 +77,9 @@ int run(int* argc, char*** argv) {
   PetscPrintf(comm, " (%s", boundary_name(g.bc[0]));
   for (int d = 1; d < g.dim; ++d)
     PetscPrintf(comm, ",%s", boundary_name(g.bc[d]));
-  PetscPrintf(comm, "), %s stencil, dt %g (explicit bound %g), %lld steps, %d rank%s -> %s/\n",
-              sim.stencil().name.c_str(), sim.dt(), sim.stable_dt(),
+  PetscPrintf(comm, "), %s stencil, dt %s (explicit bound %s), %lld steps, %d rank%s -> %s/\n",
+              sim.stencil().name.c_str(), format_double(sim.dt()).c_str(),
+              format_double(sim.stable_dt()).c_str(),
               static_cast<long long>(sim.steps()), size, size == 1 ? "" : "s",
               sim.output().dir.c_str());
   prepare_output(comm, opt, sim);

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <sstream>
 
 namespace morphogen {
@@ -17,10 +18,12 @@ std::string format_double(double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.17g", v);
   // Prefer the shortest representation that round-trips.
+  // Numbers of ordinary size are written without an exponent (20, not 2e+01).
+  const bool plain = std::abs(v) >= 1e-4 && std::abs(v) < 1e7;
   for (int prec = 1; prec <= 17; ++prec) {
     char b2[64];
     std::snprintf(b2, sizeof b2, "%.*g", prec, v);
-    if (std::strtod(b2, nullptr) == v) return b2;
+    if (std::strtod(b2, nullptr) == v && !(plain && std::strchr(b2, 'e'))) return b2;
   }
   return buf;
 }
@@ -64,7 +67,6 @@ std::optional<std::string> Options::get(const std::string& name, const std::stri
   MG_PETSC(PetscOptionsGetString(nullptr, nullptr, key.c_str(), buf, sizeof buf, &set));
   if (!set) {
     known_.push_back(name);
-    if (help_) MG_PETSC(PetscPrintf(comm_, "  -%s <unset>: %s\n", name.c_str(), help.c_str()));
     return std::nullopt;
   }
   record(name, buf, help);
