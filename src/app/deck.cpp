@@ -38,10 +38,15 @@ std::string load_deck(int* argc, char*** argv) {
     if (!err.empty()) throw UserError("deck " + deck + ": not a valid YAML deck (" + err + ")");
     base_dir = std::filesystem::path(deck).parent_path().string();
   } else {
-    PetscBool f1 = PETSC_FALSE, f2 = PETSC_FALSE;
+    // The default deck is Sanderson Fig. 1: it applies unless an options file is given or a
+    // different model is chosen (then the model's own defaults apply).
+    PetscBool f1 = PETSC_FALSE, f2 = PETSC_FALSE, has_model = PETSC_FALSE;
+    char model[256] = "";
     MG_PETSC(PetscOptionsHasName(nullptr, nullptr, "-options_file", &f1));
     MG_PETSC(PetscOptionsHasName(nullptr, nullptr, "-options_file_yaml", &f2));
-    if (!f1 && !f2) MG_PETSC(PetscOptionsInsertStringYAML(nullptr, kDefaultDeck));
+    MG_PETSC(PetscOptionsGetString(nullptr, nullptr, "-model", model, sizeof model, &has_model));
+    const bool other_model = has_model && std::string(model) != "turing";
+    if (!f1 && !f2 && !other_model) MG_PETSC(PetscOptionsInsertStringYAML(nullptr, kDefaultDeck));
   }
   // The command line (and any -options_file) overrides the deck.
   MG_PETSC(PetscOptionsInsert(nullptr, argc, argv, nullptr));
