@@ -8,21 +8,6 @@
 
 namespace morphogen {
 
-namespace {
-
-// Run a PETSc call with errors returned (not printed as a trace); message on failure.
-template <class F> std::string quietly(F&& f) {
-  MG_PETSC(PetscPushErrorHandler(PetscReturnErrorHandler, nullptr));
-  const PetscErrorCode ierr = f();
-  MG_PETSC(PetscPopErrorHandler());
-  if (!ierr) return {};
-  const char* text = nullptr;
-  PetscErrorMessage(ierr, &text, nullptr);
-  return text ? text : "error";
-}
-
-} // namespace
-
 std::string load_deck(int* argc, char*** argv) {
   std::string deck, base_dir;
   if (*argc > 1 && (*argv)[1][0] != '-') deck = (*argv)[1];
@@ -32,7 +17,7 @@ std::string load_deck(int* argc, char*** argv) {
       throw UserError("deck " + deck + ": no such file");
     std::ifstream probe(deck);
     if (!probe) throw UserError("deck " + deck + ": cannot be read");
-    const std::string err = quietly([&] {
+    const std::string err = petsc_quietly([&] {
       return PetscOptionsInsertFileYAML(PETSC_COMM_WORLD, nullptr, deck.c_str(), PETSC_TRUE);
     });
     if (!err.empty()) throw UserError("deck " + deck + ": not a valid YAML deck (" + err + ")");

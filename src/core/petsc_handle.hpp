@@ -6,6 +6,7 @@
 #include <petscdm.h>
 #include <petscsf.h>
 #include <petscvec.h>
+#include <string>
 #include <utility>
 
 namespace morphogen {
@@ -52,6 +53,21 @@ struct PetscFailure : std::exception {
   const char* what() const noexcept override { return "PETSc error (trace above)"; }
 };
 
+} // namespace morphogen
+
+namespace morphogen {
+// Run PETSc calls with errors returned instead of printed as a trace, for errors caused by
+// user input (an unparsable deck, a grid too small for the rank count). Returns PETSc's
+// message, or "" on success.
+template <class F> std::string petsc_quietly(F&& f) {
+  PetscPushErrorHandler(PetscReturnErrorHandler, nullptr);
+  const PetscErrorCode ierr = f();
+  PetscPopErrorHandler();
+  if (!ierr) return {};
+  const char* text = nullptr;
+  PetscErrorMessage(ierr, &text, nullptr);
+  return text ? text : "error";
+}
 } // namespace morphogen
 
 // PetscCall for functions that do not return PetscErrorCode: PETSc prints its trace, then we

@@ -28,15 +28,27 @@ Grid::Grid(MPI_Comm comm, const GridSpec& spec) : spec_(spec) {
     return spec_.bc[d] == Boundary::Periodic ? DM_BOUNDARY_PERIODIC : DM_BOUNDARY_GHOSTED;
   };
   const DMDAStencilType st = spec.box_stencil ? DMDA_STENCIL_BOX : DMDA_STENCIL_STAR;
-  if (spec.dim == 2) {
-    MG_PETSC(DMDACreate2d(comm, dmbc(0), dmbc(1), st, spec_.n[0], spec_.n[1], PETSC_DECIDE,
-                          PETSC_DECIDE, 1, spec.stencil_width, nullptr, nullptr, dm_.out()));
-  } else {
-    MG_PETSC(DMDACreate3d(comm, dmbc(0), dmbc(1), dmbc(2), st, spec_.n[0], spec_.n[1], spec_.n[2],
-                          PETSC_DECIDE, PETSC_DECIDE, PETSC_DECIDE, 1, spec.stencil_width, nullptr,
-                          nullptr, nullptr, dm_.out()));
+  // A grid too small for the rank count is a user error, not an internal one.
+  const std::string err = petsc_quietly([&]() -> PetscErrorCode {
+    if (spec.dim == 2)
+      PetscCall(DMDACreate2d(comm, dmbc(0), dmbc(1), st, spec_.n[0], spec_.n[1], PETSC_DECIDE,
+                             PETSC_DECIDE, 1, spec.stencil_width, nullptr, nullptr, dm_.out()));
+    else
+      PetscCall(DMDACreate3d(comm, dmbc(0), dmbc(1), dmbc(2), st, spec_.n[0], spec_.n[1],
+                             spec_.n[2], PETSC_DECIDE, PETSC_DECIDE, PETSC_DECIDE, 1,
+                             spec.stencil_width, nullptr, nullptr, nullptr, dm_.out()));
+    PetscCall(DMSetUp(dm_));
+    return 0;
+  });
+  if (!err.empty()) {
+    int size = 1;
+    MPI_Comm_size(comm, &size);
+    std::string n = std::to_string(spec_.n[0]);
+    for (int d = 1; d < spec.dim; ++d) n += "," + std::to_string(spec_.n[d]);
+    throw UserError("-grid_n " + n + ": cannot be split over " + std::to_string(size) +
+                    " ranks (each rank needs at least " + std::to_string(spec.stencil_width) +
+                    " cells per axis; PETSc: " + err + ")");
   }
-  MG_PETSC(DMSetUp(dm_));
   MG_PETSC(DMDASetUniformCoordinates(dm_, 0.5 * spec_.h(0), spec_.L[0] - 0.5 * spec_.h(0),
                                      0.5 * spec_.h(1), spec_.L[1] - 0.5 * spec_.h(1),
                                      0.5 * spec_.h(2), spec_.L[2] - 0.5 * spec_.h(2)));

@@ -100,3 +100,11 @@ def test_unwritable_output_dir(workdir):
 def test_force_dt_runs(workdir):
     proc = run(["-grid_n", "32,32", "-dt", "1.2", "-force_dt", "-steps", "5", "-output_dir", str(workdir / "o")], cwd=workdir)
     assert proc.returncode == 0, proc.stderr
+
+
+def test_grid_too_small_for_ranks(workdir):
+    proc = run(["-grid_n", "3,3", "-steps", "2", "-output_dir", str(workdir / "o")], cwd=workdir, ranks=8)
+    assert proc.returncode != 0
+    lines = error_lines(proc)
+    assert len(lines) == 1 and "-grid_n 3,3: cannot be split over 8 ranks" in lines[0], proc.stderr
+    assert not (workdir / "o").exists()
