@@ -1,7 +1,8 @@
 // Decks: YAML files loaded into PETSc's options database (nested keys become prefixed options,
 // lists become comma-separated values). Precedence, lowest first: the deck (or, with no deck,
 // no -options_file and no -model other than turing, the embedded default deck
-// input/turing_spots.yaml), then the command line. Returns the directory of the deck (for relative file names inside it), or "".
+// input/turing_spots.yaml), then the command line. Returns the directory of the deck (for relative
+// file names inside it), or "".
 #pragma once
 
 #include <string>

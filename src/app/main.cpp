@@ -79,9 +79,8 @@ int run(int* argc, char*** argv) {
     PetscPrintf(comm, ",%s", boundary_name(g.bc[d]));
   PetscPrintf(comm, "), %s stencil, dt %s (explicit bound %s), %lld steps, %d rank%s -> %s/\n",
               sim.stencil().name.c_str(), format_double(sim.dt()).c_str(),
-              format_double(sim.stable_dt()).c_str(),
-              static_cast<long long>(sim.steps()), size, size == 1 ? "" : "s",
-              sim.output().dir.c_str());
+              format_double(sim.stable_dt()).c_str(), static_cast<long long>(sim.steps()), size,
+              size == 1 ? "" : "s", sim.output().dir.c_str());
   prepare_output(comm, opt, sim);
   run_loop(sim);
   PetscPrintf(comm, "done: images in %s/ (*_final.png), options in %s/options_used.yaml\n",

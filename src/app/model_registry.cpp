@@ -21,12 +21,12 @@ template <class M> ModelEntry make_entry() {
   e.rates = &M::rates;
   e.jacobian = &M::jacobian;
   e.steady_state = &M::steady_state;
-  e.explicit_row[0][0] = &explicit_row<M, 5, false>;
-  e.explicit_row[0][1] = &explicit_row<M, 7, false>;
-  e.explicit_row[0][2] = &explicit_row<M, 9, false>;
-  e.explicit_row[1][0] = &explicit_row<M, 5, true>;
-  e.explicit_row[1][1] = &explicit_row<M, 7, true>;
-  e.explicit_row[1][2] = &explicit_row<M, 9, true>;
+  e.explicit_row[0][0] = &explicit_row<M, 3, false, false>; // 5pt
+  e.explicit_row[0][1] = &explicit_row<M, 5, false, false>; // 7pt
+  e.explicit_row[0][2] = &explicit_row<M, 3, true, false>;  // 9pt
+  e.explicit_row[1][0] = &explicit_row<M, 3, false, true>;
+  e.explicit_row[1][1] = &explicit_row<M, 5, false, true>;
+  e.explicit_row[1][2] = &explicit_row<M, 3, true, true>;
   return e;
 }
 
@@ -36,8 +36,8 @@ template <class Tuple, size_t... I> std::vector<ModelEntry> make_all(std::index_
 
 } // namespace
 
-ExplicitRowFn ModelEntry::row_kernel(bool field_params, int nterms) const {
-  const int idx = nterms == 5 ? 0 : nterms == 7 ? 1 : nterms == 9 ? 2 : -1;
+ExplicitRowFn ModelEntry::row_kernel(bool field_params, int nrows, bool box) const {
+  const int idx = !box && nrows == 3 ? 0 : !box && nrows == 5 ? 1 : box && nrows == 3 ? 2 : -1;
   return idx < 0 ? nullptr : explicit_row[field_params ? 1 : 0][idx];
 }
 

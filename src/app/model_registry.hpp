@@ -26,10 +26,12 @@ struct ModelEntry {
   void (*rates)(const double* u, const double* p, double* r);
   void (*jacobian)(const double* u, const double* p, double* J);
   bool (*steady_state)(const double* p, double* u);
-  // explicit_row[field_params][stencil]: stencil 0 = 5 terms, 1 = 7 terms, 2 = 9 terms.
+  // explicit_row[field_params][stencil]: stencil 0 = 5pt (3 star rows), 1 = 7pt (5 star rows),
+  // 2 = 9pt (3 box rows); see RowStencil.
   ExplicitRowFn explicit_row[2][3];
 
-  ExplicitRowFn row_kernel(bool field_params, int nterms) const;
+  // nullptr for a row layout without an instantiated kernel.
+  ExplicitRowFn row_kernel(bool field_params, int nrows, bool box) const;
 };
 
 const std::vector<ModelEntry>& model_registry();

@@ -195,7 +195,10 @@ void Simulation::read_model(Options& opt, const std::string& base_dir) {
       }
     }
   }
-  const ExplicitIntegrator::RowFn fn = model_->row_kernel(params_.any_field(), stencil_.nterms);
+  RowStencil rows;
+  to_rows(stencil_, rows);
+  const ExplicitIntegrator::RowFn fn =
+      model_->row_kernel(params_.any_field(), rows.nrows, rows.box);
   integrator_ = std::make_unique<ExplicitIntegrator>(
       *grid_, *halo_, fn, ns, stencil_, D_, floor_, params_, any_dirichlet ? &dirichlet_ : nullptr);
   integrator_->update_ghosts(u_);

@@ -44,7 +44,8 @@ Grid::Grid(MPI_Comm comm, const GridSpec& spec) : spec_(spec) {
     int size = 1;
     MPI_Comm_size(comm, &size);
     std::string n = std::to_string(spec_.n[0]);
-    for (int d = 1; d < spec.dim; ++d) n += "," + std::to_string(spec_.n[d]);
+    for (int d = 1; d < spec.dim; ++d)
+      n += "," + std::to_string(spec_.n[d]);
     throw UserError("-grid_n " + n + ": cannot be split over " + std::to_string(size) +
                     " ranks (each rank needs at least " + std::to_string(spec.stencil_width) +
                     " cells per axis; PETSc: " + err + ")");

@@ -12,6 +12,7 @@ ExplicitIntegrator::ExplicitIntegrator(const Grid& grid, const Halo& halo, RowFn
                                        const std::vector<FaceValues>* dirichlet)
     : grid_(grid), halo_(halo), row_fn_(row_fn), ns_(nspecies), stencil_(stencil), D_(std::move(D)),
       floor_(std::move(floor)), params_(params), dirichlet_(dirichlet) {
+  to_rows(stencil_, rows_);
   if (params_.any_field())
     for (size_t q = 0; q < params_.scalar.size(); ++q)
       const_rows_.emplace_back(params_.field[q].get() ? 0 : grid.owned().m[0], params_.scalar[q]);
@@ -41,7 +42,7 @@ void ExplicitIntegrator::update_ghosts(std::vector<VecH>& u) const {
 
 void ExplicitIntegrator::step(std::vector<VecH>& u, std::vector<VecH>& work, double dt) const {
   update_ghosts(u);
-  const int nt = stencil_.nterms;
+  const int nr = rows_.nrows;
   const int np = static_cast<int>(params_.scalar.size());
   const bool field_mode = params_.any_field();
   std::vector<const PetscScalar*> in(ns_);
@@ -56,16 +57,16 @@ void ExplicitIntegrator::step(std::vector<VecH>& u, std::vector<VecH>& work, dou
 
   const Box& ob = grid_.owned();
   const PetscInt gx = grid_.ghosted().m[0], gxy = gx * grid_.ghosted().m[1];
-  std::vector<PetscInt> delta(nt);
-  for (int t = 0; t < nt; ++t)
-    delta[t] = stencil_.off[t][0] + gx * stencil_.off[t][1] + gxy * stencil_.off[t][2];
-  std::vector<const double*> src(static_cast<size_t>(ns_ * nt));
+  std::vector<PetscInt> delta(nr);
+  for (int r = 0; r < nr; ++r)
+    delta[r] = gx * rows_.off[r][0] + gxy * rows_.off[r][1];
+  std::vector<const double*> src(static_cast<size_t>(ns_ * nr));
   std::vector<double*> dst(ns_);
   std::vector<const double*> prow(np, nullptr);
   ExplicitRow row;
   row.n = static_cast<int>(ob.m[0]);
   row.src = src.data();
-  row.w = stencil_.w.data();
+  row.w = rows_.w.data();
   row.D = D_.data();
   row.floor = floor_.data();
   row.prow = prow.data();
@@ -84,8 +85,8 @@ void ExplicitIntegrator::step(std::vector<VecH>& u, std::vector<VecH>& work, dou
       for (PetscInt j = jb; j < std::min(jb + jblock, ob.s[1] + ob.m[1]); ++j) {
         const PetscInt c = grid_.local_index(ob.s[0], j, k);
         for (int s = 0; s < ns_; ++s) {
-          for (int t = 0; t < nt; ++t)
-            src[s * nt + t] = in[s] + c + delta[t];
+          for (int r = 0; r < nr; ++r)
+            src[s * nr + r] = in[s] + c + delta[r];
           dst[s] = out[s] + c;
         }
         if (field_mode) {

@@ -22,7 +22,7 @@ namespace morphogen {
 class ExplicitIntegrator {
 public:
   using RowFn = void (*)(const ExplicitRow&);
-  // row_fn must match (nspecies, nparams, stencil.nterms, params.any_field()).
+  // row_fn must match (nspecies, nparams, the stencil's row form, params.any_field()).
   ExplicitIntegrator(const Grid& grid, const Halo& halo, RowFn row_fn, int nspecies,
                      const Stencil& stencil, std::vector<double> D, std::vector<double> floor,
                      const ParamSet& params, const std::vector<FaceValues>* dirichlet);
@@ -41,6 +41,7 @@ private:
   RowFn row_fn_;
   int ns_;
   Stencil stencil_;
+  RowStencil rows_;
   std::vector<double> D_, floor_;
   const ParamSet& params_;
   const std::vector<FaceValues>* dirichlet_;

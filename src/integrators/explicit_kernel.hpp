@@ -1,43 +1,48 @@
 // Fused explicit Euler sweep over one row of cells (pure kernel: no PETSc, MPI, allocation).
 //
+// The Laplacian is given in row form (operators/stencil.hpp, RowStencil): NR grid rows
+// (row 0 is the cell's own row), each with three x-taps w[r][0..2] for x offsets -1, 0, +1.
 // For each cell i of the row and each species s:
-//   lap_s   = sum_t w_t u_s(i + off_t)                 (stencil term 0 is the cell itself)
-//   out_s   = max( u_s + dt (D_s lap_s + R_s(u; p)),  floor_s )
-// floor_s is 0 when negative concentrations are clamped and -inf otherwise (branch-free).
-// Parameters are either scalars (FieldParams = false: one value for the whole grid, kept in
-// registers) or rows of per-cell values (FieldParams = true). The loop over i carries
-// `GCC ivdep` (rows never alias): the model's rates() inline into it and GCC vectorises it
-// (build with -DMORPHOGEN_VEC_REPORT=ON to see "loop vectorized" for explicit_kernel.hpp).
-// (`omp simd` is not used: it turns the small per-cell arrays into "simd arrays" and GCC 12
-// then refuses to vectorise.)
+//   lap_s = sum_r ( w[r][0] u_s,r[i-1] + w[r][1] u_s,r[i] + w[r][2] u_s,r[i+1] )
+//   out_s = max( u_s + dt (D_s lap_s + R_s(u; p)),  floor_s )
+// Star stencils (5pt, 7pt: Box = false) use only the centre tap of rows r > 0; box stencils
+// (9pt) use all three. One pointer per (species, row) keeps the live registers low (the x
+// neighbours are the same pointer at i -+ 1). floor_s is 0 when negative concentrations are
+// clamped and -inf otherwise (branch-free). Parameters are scalars (FieldParams = false: kept
+// in registers) or rows of per-cell values (FieldParams = true). The loop over i carries
+// `GCC ivdep` (rows never alias); the model's rates() inline into it and GCC vectorises it
+// (configure with -DMORPHOGEN_VEC_REPORT=ON to see "loop vectorized" for this file).
+// (`omp simd` is not used: GCC 12 turns the small per-cell arrays into "simd arrays" and then
+// refuses to vectorise.)
 #pragma once
 
 namespace morphogen {
 
 struct ExplicitRow {
-  int n = 0; // cells in the row
-  const double* const* src =
-      nullptr;                   // [nspecies * nterms]: src[s*NT+t][i] = u_s at neighbour t of i
-  const double* w = nullptr;     // [nterms] stencil weights (include 1/h^2)
-  const double* D = nullptr;     // [nspecies] diffusion coefficients
-  const double* floor = nullptr; // [nspecies] lower bound (0 or -inf)
+  int n = 0;                           // cells in the row
+  const double* const* src = nullptr;  // [nspecies * nrows]: src[s*NR+r] = row r of species s
+  const double* w = nullptr;           // [nrows * 3] x-taps per row (include 1/h^2)
+  const double* D = nullptr;           // [nspecies] diffusion coefficients
+  const double* floor = nullptr;       // [nspecies] lower bound (0 or -inf)
   const double* const* prow = nullptr; // [nparams] per-cell parameter rows (field mode)
   const double* pconst = nullptr;      // [nparams] parameter scalars (scalar mode)
   double dt = 0;
   double* const* dst = nullptr; // [nspecies] output rows
 };
 
-template <class M, int NT, bool FieldParams> inline void explicit_row(const ExplicitRow& a) {
+template <class M, int NR, bool Box, bool FieldParams>
+inline void explicit_row(const ExplicitRow& a) {
   constexpr int NS = M::nspecies;
   constexpr int NP = M::nparams;
-  const double* __restrict__ src[NS * NT];
+  const double* __restrict__ src[NS * NR];
   double* __restrict__ dst[NS];
-  double w[NT], D[NS], floor[NS], pc[NP > 0 ? NP : 1];
+  double w[NR][3], D[NS], floor[NS], pc[NP > 0 ? NP : 1];
   const double* __restrict__ prow[NP > 0 ? NP : 1];
-  for (int q = 0; q < NS * NT; ++q)
+  for (int q = 0; q < NS * NR; ++q)
     src[q] = a.src[q];
-  for (int t = 0; t < NT; ++t)
-    w[t] = a.w[t];
+  for (int r = 0; r < NR; ++r)
+    for (int c = 0; c < 3; ++c)
+      w[r][c] = a.w[3 * r + c];
   for (int s = 0; s < NS; ++s) {
     dst[s] = a.dst[s];
     D[s] = a.D[s];
@@ -61,12 +66,18 @@ template <class M, int NT, bool FieldParams> inline void explicit_row(const Expl
         p[q] = pc[q];
     }
     for (int s = 0; s < NS; ++s)
-      u[s] = src[s * NT][i];
+      u[s] = src[s * NR][i];
     M::rates(u, p, r);
     for (int s = 0; s < NS; ++s) {
-      double lap = w[0] * u[s];
-      for (int t = 1; t < NT; ++t)
-        lap += w[t] * src[s * NT + t][i];
+      const double* __restrict__ c = src[s * NR];
+      double lap = w[0][0] * c[i - 1] + w[0][1] * u[s] + w[0][2] * c[i + 1];
+      for (int q = 1; q < NR; ++q) {
+        const double* __restrict__ row = src[s * NR + q];
+        if constexpr (Box)
+          lap += w[q][0] * row[i - 1] + w[q][1] * row[i] + w[q][2] * row[i + 1];
+        else
+          lap += w[q][1] * row[i];
+      }
       const double v = u[s] + dt * (D[s] * lap + r[s]);
       dst[s][i] = v > floor[s] ? v : floor[s];
     }

@@ -37,4 +37,25 @@ bool make_stencil(const std::string& name, int dim, const double* h, Stencil& s)
   return true;
 }
 
+bool to_rows(const Stencil& s, RowStencil& out) {
+  RowStencil r;
+  r.off[0] = {0, 0};
+  r.nrows = 1;
+  for (int t = 0; t < s.nterms; ++t) {
+    const int dx = s.off[t][0];
+    if (dx < -1 || dx > 1) return false;
+    int row = -1;
+    for (int q = 0; q < r.nrows; ++q)
+      if (r.off[q][0] == s.off[t][1] && r.off[q][1] == s.off[t][2]) row = q;
+    if (row < 0) {
+      row = r.nrows++;
+      r.off[row] = {s.off[t][1], s.off[t][2]};
+    }
+    r.w[3 * row + dx + 1] += s.w[t];
+    if (row > 0 && dx != 0) r.box = true;
+  }
+  out = r;
+  return true;
+}
+
 } // namespace morphogen

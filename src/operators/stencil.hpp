@@ -52,6 +52,19 @@ struct Stencil {
   }
 };
 
+// The same stencil grouped by grid row, the form the explicit kernel consumes: row r has offset
+// (dy, dz) and x-taps w[r] = {weight at x-1, x, x+1}. Row 0 is the centre row. `box` is true
+// when a row other than the centre one has x-taps (9pt), false for star stencils (5pt, 7pt).
+struct RowStencil {
+  int nrows = 0;
+  bool box = false;
+  std::array<std::array<int, 2>, 9> off{};
+  std::array<double, 27> w{}; // w[3*r + (dx+1)]
+};
+
+// Group a stencil with x offsets in [-1, 1] into rows; false if it has wider x offsets.
+bool to_rows(const Stencil& s, RowStencil& out);
+
 // Names accepted by make_stencil for the given dimension: "5pt" and "9pt" in 2-D, "7pt" in 3-D.
 // Returns false (stencil untouched) for an unknown name or a 9pt stencil with hx != hy.
 bool make_stencil(const std::string& name, int dim, const double* h, Stencil& out);

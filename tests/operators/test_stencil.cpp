@@ -85,3 +85,33 @@ TEST(Stencil, SpectralRadiusAndStableDt) {
   EXPECT_NEAR(ExplicitIntegrator::stable_dt(s7, {0.4}), 0.25 / (6 * 0.4), 1e-15);
   EXPECT_TRUE(std::isinf(ExplicitIntegrator::stable_dt(s5, {0.0, 0.0})));
 }
+
+TEST(Stencil, RowFormGroupsTermsByRow) {
+  const double h[3] = {0.5, 0.25, 0.2};
+  const double hs[3] = {0.5, 0.5, 0.5};
+  Stencil s5, s7, s9;
+  ASSERT_TRUE(make_stencil("5pt", 2, h, s5));
+  ASSERT_TRUE(make_stencil("7pt", 3, h, s7));
+  ASSERT_TRUE(make_stencil("9pt", 2, hs, s9));
+  for (const Stencil* s : {&s5, &s7, &s9}) {
+    RowStencil r;
+    ASSERT_TRUE(to_rows(*s, r));
+    EXPECT_EQ(r.nrows, s == &s7 ? 5 : 3);
+    EXPECT_EQ(r.box, s == &s9);
+    EXPECT_EQ(r.off[0][0], 0);
+    EXPECT_EQ(r.off[0][1], 0);
+    // The row form applied to a quadratic equals the stencil applied to it.
+    auto f = [](double x, double y, double z) { return x * x - 3 * y * y + 2 * z * z + x * y; };
+    double rows_sum = 0;
+    for (int q = 0; q < r.nrows; ++q)
+      for (int dx = -1; dx <= 1; ++dx)
+        rows_sum += r.w[3 * q + dx + 1] * f(0.1 + dx * (s == &s9 ? hs : h)[0],
+                                            0.2 + r.off[q][0] * (s == &s9 ? hs : h)[1],
+                                            0.3 + r.off[q][1] * (s == &s9 ? hs : h)[2]);
+    const double* hh = s == &s9 ? hs : h;
+    const double direct = s->apply([&](int dx, int dy, int dz) {
+      return f(0.1 + dx * hh[0], 0.2 + dy * hh[1], 0.3 + dz * hh[2]);
+    });
+    EXPECT_NEAR(rows_sum, direct, 1e-10);
+  }
+}
