@@ -1,6 +1,7 @@
 #include "app/run_loop.hpp"
 
 #include "core/collective_error.hpp"
+#include "core/log_events.hpp"
 #include "core/user_error.hpp"
 #include "io/png_file.hpp"
 #include "io/slice_gather.hpp"
@@ -17,6 +18,7 @@ void write_pngs(Simulation& sim, const std::string& tag) {
   int rank = 0;
   MPI_Comm_rank(g.comm(), &rank);
   std::string err;
+  LogScope log_scope(log_events().output);
   for (int s : sim.output().png_species) {
     const PetscScalar* a;
     MG_PETSC(VecGetArrayRead(sim.state()[s], &a));

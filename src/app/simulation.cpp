@@ -1,6 +1,7 @@
 #include "app/simulation.hpp"
 
 #include "core/collective_error.hpp"
+#include "core/log_events.hpp"
 #include "core/user_error.hpp"
 #include "fields/field_fill.hpp"
 
@@ -15,6 +16,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 }
 
 Simulation::Simulation(MPI_Comm comm, Options& opt, const std::string& base_dir) : comm_(comm) {
+  LogScope log_scope(log_events().setup);
   read_grid(opt);
   read_model(opt, base_dir);
   read_time(opt);
@@ -164,6 +166,9 @@ void Simulation::read_model(Options& opt, const std::string& base_dir) {
                              std::string("Dirichlet boundary value of ") + si.name +
                                  " (expression of the face position)"),
                   spec_, seed_, base_dir);
+      if (g.uses_time())
+        throw UserError("-" + dkey + " " + g.text() +
+                        ": time-dependent boundary values (t) are not supported yet");
       const Box& gb = grid_->ghosted();
       for (int d = 0; d < spec_.dim; ++d) {
         if (spec_.bc[d] != Boundary::Dirichlet) continue;

@@ -96,21 +96,19 @@ int run(MPI_Comm comm) {
   const double roof = bw / 32.0;
   PetscPrintf(comm, "ranks=%d\nstream_triad_GBps=%.2f\nroofline_cell_updates_per_s=%.4e\n", size,
               bw / 1e9, roof);
+  auto report = [&](const char* tag, const char* grid, const Result& r) {
+    PetscPrintf(comm,
+                "explicit_%s grid=%s model=gray_scott bytes_per_update=32 "
+                "cell_updates_per_s=%.4e fraction=%.3f\n",
+                tag, grid, r.cups, r.cups / roof);
+    PetscPrintf(comm, "halo_%s halo_only_update_ms=%.4f dm_global_to_local_ms=%.4f\n", tag,
+                1e3 * r.halo_s, 1e3 * r.g2l_s);
+  };
   const Result r2 = bench_explicit(comm, opt, "1024,1024", static_cast<int>(steps2));
   opt.check_unused();
-  PetscPrintf(comm,
-              "explicit_2d grid=1024x1024 model=gray_scott bytes_per_update=32 "
-              "cell_updates_per_s=%.4e fraction=%.3f\n",
-              r2.cups, r2.cups / roof);
-  PetscPrintf(comm, "halo_2d halo_only_update_ms=%.4f dm_global_to_local_ms=%.4f\n",
-              1e3 * r2.halo_s, 1e3 * r2.g2l_s);
+  report("2d", "1024x1024", r2);
   const Result r3 = bench_explicit(comm, opt, "128,128,128", static_cast<int>(steps3));
-  PetscPrintf(comm,
-              "explicit_3d grid=128x128x128 model=gray_scott bytes_per_update=32 "
-              "cell_updates_per_s=%.4e fraction=%.3f\n",
-              r3.cups, r3.cups / roof);
-  PetscPrintf(comm, "halo_3d halo_only_update_ms=%.4f dm_global_to_local_ms=%.4f\n",
-              1e3 * r3.halo_s, 1e3 * r3.g2l_s);
+  report("3d", "128x128x128", r3);
   PetscPrintf(comm, "roofline_fraction=%.3f\n", r2.cups / roof);
   return 0;
 }

@@ -1,5 +1,7 @@
 #include "integrators/explicit_integrator.hpp"
 
+#include "core/log_events.hpp"
+
 #include <algorithm>
 #include <limits>
 #include <utility>
@@ -27,6 +29,7 @@ double ExplicitIntegrator::stable_dt(const Stencil& stencil, const std::vector<d
 }
 
 void ExplicitIntegrator::update_ghosts(std::vector<VecH>& u) const {
+  LogScope log_scope(log_events().halo);
   std::vector<PetscScalar*> a(ns_);
   for (int s = 0; s < ns_; ++s)
     MG_PETSC(VecGetArray(u[s], &a[s]));
@@ -42,6 +45,7 @@ void ExplicitIntegrator::update_ghosts(std::vector<VecH>& u) const {
 
 void ExplicitIntegrator::step(std::vector<VecH>& u, std::vector<VecH>& work, double dt) const {
   update_ghosts(u);
+  LogScope log_scope(log_events().sweep);
   const int nr = rows_.nrows;
   const int np = static_cast<int>(params_.scalar.size());
   const bool field_mode = params_.any_field();

@@ -32,6 +32,17 @@ MG_HD inline void barkley_dra(double A, double B, const double* p, double* J) {
   J[0] = ((1.0 - 2.0 * A) * (A - th) + A * (1.0 - A)) / eps;
   J[1] = -A * (1.0 - A) / (a * eps);
 }
+constexpr std::array<SpeciesInfo, 2> barkley_species{{
+    {"A", 1.0, 0.0, "fast excitation variable"},
+    {"B", 0.0, 0.0, "slow recovery variable (does not diffuse)"},
+}};
+constexpr std::array<ParamInfo, 3> barkley_params(double b, double eps) {
+  return {{
+      {"a", 0.75, 1e-6, 1e3, "threshold scale: threshold is (B + b) / a"},
+      {"b", b, 0.0, 1e3, "threshold offset (excitability)"},
+      {"eps", eps, 1e-6, 1e3, "time-scale ratio of A to B (small: stiff, sharp fronts)"},
+  }};
+}
 inline bool barkley_steady_state(const double* p, double* u) {
   if (!(p[0] > 0.0 && p[2] > 0.0)) return false;
   u[0] = 0.0;
@@ -47,15 +58,8 @@ struct Barkley {
       "Stable advection-reaction-diffusion with arbitrary anisotropy, Appendix A (Barkley 1991)";
   static constexpr int nspecies = 2;
   static constexpr int nparams = 3;
-  static constexpr std::array<SpeciesInfo, 2> species{{
-      {"A", 1.0, 0.0, "fast excitation variable"},
-      {"B", 0.0, 0.0, "slow recovery variable (does not diffuse)"},
-  }};
-  static constexpr std::array<ParamInfo, 3> params{{
-      {"a", 0.75, 1e-6, 1e3, "threshold scale: threshold is (B + b) / a"},
-      {"b", 0.02, 0.0, 1e3, "threshold offset (excitability)"},
-      {"eps", 0.02, 1e-6, 1e3, "time-scale ratio of A to B (small: stiff, sharp fronts)"},
-  }};
+  static constexpr std::array<SpeciesInfo, 2> species = detail::barkley_species;
+  static constexpr std::array<ParamInfo, 3> params = detail::barkley_params(0.02, 0.02);
   static constexpr bool clamp_default = false;
 
   MG_HD static inline void rates(const double* u, const double* p, double* r) {
@@ -80,15 +84,8 @@ struct BarkleyTurbulent {
       "Stable advection-reaction-diffusion with arbitrary anisotropy, Appendix A (Barkley 1991)";
   static constexpr int nspecies = 2;
   static constexpr int nparams = 3;
-  static constexpr std::array<SpeciesInfo, 2> species{{
-      {"A", 1.0, 0.0, "fast excitation variable"},
-      {"B", 0.0, 0.0, "slow recovery variable (does not diffuse)"},
-  }};
-  static constexpr std::array<ParamInfo, 3> params{{
-      {"a", 0.75, 1e-6, 1e3, "threshold scale: threshold is (B + b) / a"},
-      {"b", 0.06, 0.0, 1e3, "threshold offset (excitability)"},
-      {"eps", 0.08, 1e-6, 1e3, "time-scale ratio of A to B (small: stiff, sharp fronts)"},
-  }};
+  static constexpr std::array<SpeciesInfo, 2> species = detail::barkley_species;
+  static constexpr std::array<ParamInfo, 3> params = detail::barkley_params(0.06, 0.08);
   static constexpr bool clamp_default = false;
 
   MG_HD static inline void rates(const double* u, const double* p, double* r) {
