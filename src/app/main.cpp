@@ -12,6 +12,7 @@
 #include "core/collective_error.hpp"
 #include "core/user_error.hpp"
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -100,10 +101,12 @@ int main(int argc, char** argv) {
     PetscFPrintf(PETSC_COMM_WORLD, PETSC_STDERR, "morphogen: error: %s\n", e.what());
     rc = 1;
   } catch (const PetscFailure&) {
-    rc = 2;
+    // PETSc printed its trace; the failure may be on this rank only, so abort the job rather
+    // than wait for the other ranks in PetscFinalize.
+    MPI_Abort(PETSC_COMM_WORLD, 2);
   } catch (const std::exception& e) {
-    PetscFPrintf(PETSC_COMM_WORLD, PETSC_STDERR, "morphogen: internal error: %s\n", e.what());
-    rc = 2;
+    std::fprintf(stderr, "morphogen: internal error: %s\n", e.what());
+    MPI_Abort(PETSC_COMM_WORLD, 2);
   }
   // Unused-option warnings are ours (check_unused); keep PETSc quiet about them at exit.
   PetscCall(PetscOptionsSetValue(nullptr, "-options_left", "0"));

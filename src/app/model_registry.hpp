@@ -5,6 +5,7 @@
 #pragma once
 
 #include "integrators/explicit_kernel.hpp"
+#include "integrators/split_integrator.hpp"
 #include "models/model.hpp"
 
 #include <string>
@@ -29,6 +30,8 @@ struct ModelEntry {
   // explicit_row[field_params][stencil]: stencil 0 = 5pt (3 star rows), 1 = 7pt (5 star rows),
   // 2 = 9pt (3 box rows); see RowStencil.
   ExplicitRowFn explicit_row[2][3];
+  // reaction_row[field_params]: the per-cell reaction substep of the split integrator.
+  ReactionRowFn reaction_row[2];
 
   // nullptr for a row layout without an instantiated kernel.
   ExplicitRowFn row_kernel(bool field_params, int nrows, bool box) const;

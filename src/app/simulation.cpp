@@ -15,7 +15,8 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 }
 
-Simulation::Simulation(MPI_Comm comm, Options& opt, const std::string& base_dir) : comm_(comm) {
+Simulation::Simulation(MPI_Comm comm, Options& opt, const std::string& base_dir)
+    : comm_(comm), base_dir_(base_dir) {
   LogScope log_scope(log_events().setup);
   read_grid(opt);
   read_model(opt, base_dir);
@@ -210,22 +211,59 @@ void Simulation::read_model(Options& opt, const std::string& base_dir) {
 }
 
 void Simulation::read_time(Options& opt) {
-  opt.choice("integrator", "explicit", {"explicit"},
-             "time integrator: explicit (forward Euler, diffusion and reaction fused)");
+  const std::string kind =
+      opt.choice("integrator", "explicit", {"explicit", "split"},
+                 "time integrator: explicit (forward Euler, diffusion and reaction fused) or split "
+                 "(Lie/Strang splitting, implicit diffusion by KSP, per-cell reaction by Newton)");
+  split_ = kind == "split";
   stable_dt_ = ExplicitIntegrator::stable_dt(stencil_, D_);
   const double def_dt = std::isfinite(stable_dt_) ? 0.9 * stable_dt_ : 1.0;
   dt_ = opt.real("dt", def_dt, 0.0, kInf, "time step");
   if (!(dt_ > 0)) throw UserError("-dt " + format_double(dt_) + ": must be > 0");
-  const bool force = opt.flag("force_dt", false,
-                              "run even when -dt exceeds the explicit diffusion stability bound");
-  if (dt_ > stable_dt_ && !force)
-    throw UserError("-dt " + format_double(dt_) +
-                    ": exceeds the explicit diffusion stability bound dt <= " +
-                    format_double(stable_dt_) + " (2/(D_max*rho(L)) for the " + stencil_.name +
-                    " stencil, D_max = " + format_double(*std::max_element(D_.begin(), D_.end())) +
-                    "); use a smaller -dt or -force_dt");
+  if (!split_) {
+    const bool force = opt.flag("force_dt", false,
+                                "run even when -dt exceeds the explicit diffusion stability bound");
+    if (dt_ > stable_dt_ && !force)
+      throw UserError(
+          "-dt " + format_double(dt_) + ": exceeds the explicit diffusion stability bound dt <= " +
+          format_double(stable_dt_) + " (2/(D_max*rho(L)) for the " + stencil_.name +
+          " stencil, D_max = " + format_double(*std::max_element(D_.begin(), D_.end())) +
+          "); use a smaller -dt, -integrator split (unconditionally stable "
+          "diffusion), or -force_dt");
+  }
   steps_ =
       opt.integer("steps", 1000, 0, std::numeric_limits<PetscInt>::max(), "number of time steps");
+  sources_ = std::make_unique<SourceTerms>(*grid_, opt, species_, seed_, base_dir_);
+  if (split_) {
+    SplitSettings set;
+    const std::string ord = opt.choice("split_ordering", "strang", {"lie", "strang"},
+                                       "splitting: lie (first order) or strang (second order)");
+    set.ordering = ord == "lie" ? SplitOrdering::Lie : SplitOrdering::Strang;
+    const bool strang = set.ordering == SplitOrdering::Strang;
+    const std::string rs =
+        opt.choice("split_reaction", strang ? "trapezoidal" : "backward_euler",
+                   {"euler", "heun", "backward_euler", "trapezoidal"},
+                   "reaction substep: euler, heun (explicit), backward_euler, trapezoidal "
+                   "(implicit per cell, Newton with the analytic Jacobian)");
+    set.reaction = rs == "euler"            ? ReactionScheme::Euler
+                   : rs == "heun"           ? ReactionScheme::Heun
+                   : rs == "backward_euler" ? ReactionScheme::BackwardEuler
+                                            : ReactionScheme::Trapezoidal;
+    const std::string ds =
+        opt.choice("split_diffusion", strang ? "crank_nicolson" : "backward_euler",
+                   {"backward_euler", "crank_nicolson"},
+                   "diffusion substep: backward_euler or crank_nicolson");
+    set.theta = ds == "backward_euler" ? 1.0 : 0.5;
+    set.newton_tol = opt.real("split_newton_tol", 1e-12, 1e-16, 1e-2,
+                              "relative tolerance of the per-cell Newton solve");
+    set.newton_max_it = static_cast<int>(
+        opt.integer("split_newton_max_it", 20, 1, 1000, "Newton iteration cap per cell"));
+    diffusion_ = std::make_unique<DiffusionSolver>(*grid_, *halo_, stencil_, species_, D_,
+                                                   dirichlet_.empty() ? nullptr : &dirichlet_, opt);
+    split_integrator_ = std::make_unique<SplitIntegrator>(
+        *grid_, model_->reaction_row[params_.any_field() ? 1 : 0], species_, params_, floor_,
+        sources_.get(), *diffusion_, set);
+  }
 }
 
 void Simulation::read_output(Options& opt) {
@@ -269,9 +307,32 @@ void Simulation::read_output(Options& opt) {
 }
 
 void Simulation::step() {
-  integrator_->step(u_, work_, dt_);
+  if (split_) {
+    split_integrator_->step(u_, t_, dt_, step_ + 1);
+  } else {
+    integrator_->step(u_, work_, dt_);
+    if (sources_->any()) add_sources(t_);
+  }
   t_ += dt_;
   ++step_;
+}
+
+void Simulation::add_sources(double t) {
+  // Forward Euler of the source: u += dt S(t), then the clamp floor.
+  const Box& ob = grid_->owned();
+  for (size_t s = 0; s < u_.size(); ++s) {
+    const double* S = sources_->at(static_cast<int>(s), t);
+    if (!S) continue;
+    PetscScalar* a;
+    MG_PETSC(VecGetArray(u_[s], &a));
+    for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
+      for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j)
+        for (PetscInt i = ob.s[0]; i < ob.s[0] + ob.m[0]; ++i) {
+          double& v = a[grid_->local_index(i, j, k)];
+          v = std::max(v + dt_ * S[grid_->owned_index(i, j, k)], floor_[s]);
+        }
+    MG_PETSC(VecRestoreArray(u_[s], &a));
+  }
 }
 
 void Simulation::check_finite() const {

@@ -6,8 +6,11 @@
 #include "app/model_registry.hpp"
 #include "core/options.hpp"
 #include "fields/param_set.hpp"
+#include "fields/source_terms.hpp"
 #include "grid/halo.hpp"
+#include "integrators/diffusion_solver.hpp"
 #include "integrators/explicit_integrator.hpp"
+#include "integrators/split_integrator.hpp"
 
 #include <memory>
 #include <string>
@@ -43,8 +46,11 @@ public:
   const Stencil& stencil() const { return stencil_; }
   std::uint64_t seed() const { return seed_; }
 
-  // Advance one explicit step.
+  // Advance one step with the configured integrator.
   void step();
+  bool split() const { return split_; }
+  const DiffusionSolver* diffusion_solver() const { return diffusion_.get(); }
+  const SplitIntegrator* split_integrator() const { return split_integrator_.get(); }
   // Make ghosts current (after initialisation or before reading neighbours).
   void refresh_ghosts() { integrator_->update_ghosts(u_); }
   // Collective: throws UserError naming species, cell, step and time if any value is NaN/Inf.
@@ -55,8 +61,10 @@ private:
   void read_model(Options& opt, const std::string& base_dir);
   void read_time(Options& opt);
   void read_output(Options& opt);
+  void add_sources(double t);
 
   MPI_Comm comm_;
+  std::string base_dir_;
   const ModelEntry* model_ = nullptr;
   GridSpec spec_;
   std::unique_ptr<Grid> grid_;
@@ -68,6 +76,10 @@ private:
   std::vector<FaceValues> dirichlet_;
   std::vector<VecH> u_, work_;
   std::unique_ptr<ExplicitIntegrator> integrator_;
+  std::unique_ptr<SourceTerms> sources_;
+  std::unique_ptr<DiffusionSolver> diffusion_;
+  std::unique_ptr<SplitIntegrator> split_integrator_;
+  bool split_ = false;
   std::uint64_t seed_ = 1;
   double dt_ = 0, stable_dt_ = 0, t_ = 0;
   PetscInt steps_ = 0, step_ = 0;

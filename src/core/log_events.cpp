@@ -13,6 +13,8 @@ const LogEvents& log_events() {
     MG_PETSC(PetscLogEventRegister("MgExplicitSweep", cid, &e.sweep));
     MG_PETSC(PetscLogEventRegister("MgSetup", cid, &e.setup));
     MG_PETSC(PetscLogEventRegister("MgOutput", cid, &e.output));
+    MG_PETSC(PetscLogEventRegister("MgReaction", cid, &e.reaction));
+    MG_PETSC(PetscLogEventRegister("MgDiffusion", cid, &e.diffusion));
     return e;
   }();
   return ev;

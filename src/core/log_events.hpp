@@ -1,6 +1,7 @@
 // PETSc logging events around each phase of a run, reported by -log_view:
 //   MgHalo (ghost exchange and boundary fill), MgExplicitSweep (the fused kernel sweep),
-//   MgSetup (options, grid, fields), MgOutput (PNG images).
+//   MgSetup (options, grid, fields), MgOutput (PNG images), MgReaction (split reaction
+//   substep), MgDiffusion (split implicit diffusion substep).
 #pragma once
 
 #include <petsclog.h>
@@ -8,7 +9,7 @@
 namespace morphogen {
 
 struct LogEvents {
-  PetscLogEvent halo, sweep, setup, output;
+  PetscLogEvent halo, sweep, setup, output, reaction, diffusion;
 };
 
 // Registered on first use (after PetscInitialize).

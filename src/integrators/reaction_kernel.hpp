@@ -1,0 +1,309 @@
+// Per-cell reaction update (pure kernels: no PETSc, MPI, allocation, exceptions or virtuals).
+//
+// For one cell, the reaction ODE  du/dt = R(u; p) + S(t)  is advanced by one step dt from u to
+// v. S is a source term (e.g. the explicitly treated diffusion/advection of a splitting scheme);
+// S0 = S at the start of the step, S1 = S at the end (either may be nullptr for zero):
+//   Euler          v = u + dt (R(u) + S0)                                   (order 1)
+//   Heun (RK2)     k1 = R(u) + S0,  w = u + dt k1,
+//                  v = u + dt/2 (k1 + R(w) + S1)                            (order 2)
+//   BackwardEuler  F(v) = v - u - dt (R(v) + S1)                      = 0  (order 1, L-stable)
+//   Trapezoidal    F(v) = v - u - dt/2 (R(u) + S0 + R(v) + S1)        = 0  (order 2, A-stable)
+// The implicit rules are the per-cell "implicit update rules" of the stable-ARD paper
+// (Appendix A); instead of eliminating one species by hand per model, the 2..8-species system is
+// solved by Newton with the model's analytic Jacobian,
+//   J_F = I - c dt dR/du(v),  c = 1 (BackwardEuler) or 1/2 (Trapezoidal),
+// factored by a dense LU with partial pivoting (stack arrays sized by M::nspecies <= 8).
+//
+// Newton start: the explicit Euler predictor v0 = u + dt R(u) + dt (c S1 + (1 - c) S0) or u
+// itself, whichever has the smaller max-norm residual (a non-finite predictor loses).
+// Damping: while the update is large (||dv||_inf > sqrt(tol) scale) and the full step does not
+// decrease ||F||_2^2 by the Armijo factor (1 - 2e-4 lambda), the step is halved (at most 10
+// times); if no fraction helps, the full step is taken. Near the root this is plain Newton
+// (quadratic); far from it, it roughly halves the failures of undamped Newton at dt >> 1/||J||.
+// Convergence (scale-aware, affine-invariant): with scale = 1 + max(||u||_inf, ||v||_inf),
+//   converged  <=>  ||dv||_inf <= tol * scale   for the full (undamped) update dv that gave v.
+// The update is Newton's estimate of the error of the previous iterate, so the returned v (one
+// step further) is accurate to ~tol^2 in the quadratic regime; the "1 +" makes tol absolute for
+// concentrations below 1 and relative above. The residual ||F(v)||_inf is reported but not
+// tested: for large dt, F ~ dt R(v) carries round-off of order eps dt |terms of R|, which can
+// exceed any fixed tolerance on F although v is exact to working precision (a stiff cell), while
+// the update stays a faithful error measure. tol should be well above machine epsilon (1e-13 or
+// more); an exact zero residual at the start is accepted with 0 iterations.
+// Failure (converged = false; nothing is thrown, nothing is divided by zero): a non-finite
+// input, residual or iterate, a (numerically) singular J_F (|pivot| <= eps ||J_F||_inf), or no
+// convergence within maxit iterations (maxit < 1: only the predictor is evaluated). v then holds
+// the last iterate. iterations counts LU solves. Explicit schemes report iterations = 0,
+// residual = 0 and converged = all outputs finite. Undamped or damped, Newton is local: for
+// dt >> 1/||J|| it fails from a few % of states (the caller should retry with a smaller dt).
+//
+// reaction_row applies reaction_cell to the n cells of a row (species rows u[s][i], parameters
+// as scalars or, FieldParams = true, as per-cell rows), clamps out_s = max(v_s, floor_s) (floor
+// 0 or -inf), and returns -1 when every cell converged (then *worst = {max iterations, max
+// residual, true}) or the index i of the first failed cell (then *worst = that cell's CellSolve,
+// cells [0, i) are written and cells [i, n) are left untouched). out may alias u (in place):
+// each cell's inputs are read before its outputs are written.
+#pragma once
+
+#include <cmath>
+#include <limits>
+
+namespace morphogen {
+
+enum class ReactionScheme { Euler, Heun, BackwardEuler, Trapezoidal };
+
+struct CellSolve {
+  int iterations = 0;    // Newton iterations (LU solves); 0 for explicit schemes
+  double residual = 0.0; // max-norm of F at the returned v (0 for explicit schemes)
+  bool converged = false;
+};
+
+namespace detail {
+
+constexpr int kMaxSpecies = 8;
+constexpr int kMaxHalvings = 10; // Newton damping: smallest step fraction 2^-10
+
+template <int N> inline double max_abs(const double* x) {
+  double m = 0.0;
+  for (int s = 0; s < N; ++s) {
+    const double a = std::fabs(x[s]);
+    if (a > m || std::isnan(a)) m = a; // a NaN entry makes (and keeps) the result NaN
+  }
+  return m;
+}
+
+template <int N> inline double sum_sq(const double* x) {
+  double m = 0.0;
+  for (int s = 0; s < N; ++s)
+    m += x[s] * x[s];
+  return m;
+}
+
+// Convergence scale 1 + max(||u||_inf, ||v||_inf).
+template <int N> inline double scale(double unorm, const double* v) {
+  const double vn = max_abs<N>(v);
+  return 1.0 + (unorm > vn ? unorm : vn);
+}
+
+template <int N> inline bool all_finite(const double* x) {
+  for (int s = 0; s < N; ++s)
+    if (!std::isfinite(x[s])) return false;
+  return true;
+}
+
+// Solves A x = b in place (A: N x N row-major, destroyed; b: right-hand side, overwritten by
+// x) by Gaussian elimination with partial pivoting. Returns false, leaving b unspecified, when a
+// pivot is not finite or |pivot| <= eps ||A||_inf (numerically singular).
+template <int N> inline bool lu_solve(double* A, double* b) {
+  double norm = 0.0;
+  for (int r = 0; r < N; ++r) {
+    double row = 0.0;
+    for (int c = 0; c < N; ++c)
+      row += std::fabs(A[r * N + c]);
+    if (row > norm || std::isnan(row)) norm = row;
+  }
+  if (!std::isfinite(norm) || !(norm > 0.0)) return false;
+  const double tiny = std::numeric_limits<double>::epsilon() * norm;
+  for (int k = 0; k < N; ++k) {
+    int piv = k;
+    double big = std::fabs(A[k * N + k]);
+    for (int r = k + 1; r < N; ++r) {
+      const double a = std::fabs(A[r * N + k]);
+      if (a > big) {
+        big = a;
+        piv = r;
+      }
+    }
+    if (!(big > tiny) || !std::isfinite(big)) return false;
+    if (piv != k) {
+      for (int c = 0; c < N; ++c) {
+        const double t = A[k * N + c];
+        A[k * N + c] = A[piv * N + c];
+        A[piv * N + c] = t;
+      }
+      const double t = b[k];
+      b[k] = b[piv];
+      b[piv] = t;
+    }
+    const double inv = 1.0 / A[k * N + k];
+    for (int r = k + 1; r < N; ++r) {
+      const double f = A[r * N + k] * inv;
+      if (f == 0.0) continue;
+      for (int c = k + 1; c < N; ++c)
+        A[r * N + c] -= f * A[k * N + c];
+      b[r] -= f * b[k];
+    }
+  }
+  for (int k = N - 1; k >= 0; --k) {
+    double x = b[k];
+    for (int c = k + 1; c < N; ++c)
+      x -= A[k * N + c] * b[c];
+    b[k] = x / A[k * N + k];
+  }
+  return true;
+}
+
+} // namespace detail
+
+// One cell: see the header comment. u, S0, S1 and v have M::nspecies entries (S0/S1 may be
+// nullptr for a zero source), p has M::nparams. v must not alias u.
+template <class M>
+inline CellSolve reaction_cell(ReactionScheme scheme, const double* u, const double* p,
+                               const double* S0, const double* S1, double dt, double tol, int maxit,
+                               double* v) {
+  constexpr int NS = M::nspecies;
+  static_assert(NS >= 1 && NS <= detail::kMaxSpecies, "reaction_cell: 1..8 species");
+  double s0[NS], s1[NS], ru[NS];
+  for (int s = 0; s < NS; ++s) {
+    s0[s] = S0 ? S0[s] : 0.0;
+    s1[s] = S1 ? S1[s] : 0.0;
+  }
+  M::rates(u, p, ru);
+  CellSolve out{0, 0.0, false};
+
+  if (scheme == ReactionScheme::Euler) {
+    for (int s = 0; s < NS; ++s)
+      v[s] = u[s] + dt * (ru[s] + s0[s]);
+    out.converged = detail::all_finite<NS>(v);
+    return out;
+  }
+  if (scheme == ReactionScheme::Heun) {
+    double k1[NS], w[NS], rw[NS];
+    for (int s = 0; s < NS; ++s) {
+      k1[s] = ru[s] + s0[s];
+      w[s] = u[s] + dt * k1[s];
+    }
+    M::rates(w, p, rw);
+    for (int s = 0; s < NS; ++s)
+      v[s] = u[s] + 0.5 * dt * (k1[s] + rw[s] + s1[s]);
+    out.converged = detail::all_finite<NS>(v);
+    return out;
+  }
+
+  // Implicit: F(v) = v - base - c dt (R(v) + S1), base = u (+ dt/2 (R(u) + S0) for TR).
+  const bool trap = scheme == ReactionScheme::Trapezoidal;
+  const double cdt = trap ? 0.5 * dt : dt;
+  double base[NS], pred[NS], F[NS], r[NS];
+  for (int s = 0; s < NS; ++s) {
+    base[s] = trap ? u[s] + cdt * (ru[s] + s0[s]) : u[s];
+    pred[s] = base[s] + cdt * (ru[s] + s1[s]); // explicit Euler predictor
+  }
+  const double unorm = detail::max_abs<NS>(u);
+  auto residual = [&](const double* x, double* f) {
+    M::rates(x, p, r);
+    for (int s = 0; s < NS; ++s)
+      f[s] = x[s] - base[s] - cdt * (r[s] + s1[s]);
+    return detail::max_abs<NS>(f);
+  };
+  // F(u) = u - pred exactly (algebraically), so the start u costs no rates() call.
+  double Fu[NS];
+  for (int s = 0; s < NS; ++s)
+    Fu[s] = u[s] - pred[s];
+  const double res_u = detail::max_abs<NS>(Fu);
+  double res = residual(pred, F);
+  if (res < res_u) { // false when res is NaN: the predictor loses
+    for (int s = 0; s < NS; ++s)
+      v[s] = pred[s];
+  } else {
+    res = res_u;
+    for (int s = 0; s < NS; ++s) {
+      v[s] = u[s];
+      F[s] = Fu[s];
+    }
+  }
+  out.residual = res;
+  if (!std::isfinite(res) || !std::isfinite(unorm)) return out;
+  if (res == 0.0) {
+    out.converged = true;
+    return out;
+  }
+
+  // Newton; the step is damped (halved up to kMaxHalvings times) only while it is large and
+  // the full step does not decrease ||F||_2 (Armijo); if no halving helps, the full step is
+  // taken, so this is never worse than plain Newton, and near the root it is plain Newton.
+  double J[NS * NS], dv[NS], vt[NS], Ft[NS];
+  const double big_step = std::sqrt(tol);
+  for (int it = 1; it <= maxit; ++it) {
+    M::jacobian(v, p, J);
+    for (int q = 0; q < NS * NS; ++q)
+      J[q] *= -cdt;
+    for (int s = 0; s < NS; ++s) {
+      J[s * NS + s] += 1.0;
+      dv[s] = -F[s];
+    }
+    out.iterations = it;
+    if (!detail::lu_solve<NS>(J, dv)) return out;
+    const double step = detail::max_abs<NS>(dv);
+    const bool far = step > big_step * detail::scale<NS>(unorm, v);
+    const double f2 = detail::sum_sq<NS>(F);
+    double lam = 1.0;
+    for (int halvings = 0;; ++halvings) {
+      for (int s = 0; s < NS; ++s)
+        vt[s] = v[s] + lam * dv[s];
+      res = residual(vt, Ft);
+      if (!far) break;
+      if (std::isfinite(res) && detail::sum_sq<NS>(Ft) <= (1.0 - 2e-4 * lam) * f2) break;
+      if (halvings == detail::kMaxHalvings) { // no decrease: fall back to the full step
+        lam = 1.0;
+        for (int s = 0; s < NS; ++s)
+          vt[s] = v[s] + dv[s];
+        res = residual(vt, Ft);
+        break;
+      }
+      lam *= 0.5;
+    }
+    for (int s = 0; s < NS; ++s) {
+      v[s] = vt[s];
+      F[s] = Ft[s];
+    }
+    out.residual = res;
+    if (!std::isfinite(res)) return out; // also catches a non-finite v (F contains v)
+    if (lam == 1.0 && step <= tol * detail::scale<NS>(unorm, v)) {
+      out.converged = true;
+      return out;
+    }
+  }
+  return out;
+}
+
+// One row of n cells: see the header comment. u, S0, S1 and out are [NS] row pointers (S0/S1
+// nullptr for a zero source), prow [NP] parameter rows (FieldParams) or pconst [NP] scalars,
+// floor [NS] lower clamps. worst may be nullptr.
+template <class M, bool FieldParams>
+inline int reaction_row(ReactionScheme scheme, int n, const double* const* u,
+                        const double* const* prow, const double* pconst, const double* const* S0,
+                        const double* const* S1, double dt, double tol, int maxit,
+                        const double* floor, double* const* out, CellSolve* worst) {
+  constexpr int NS = M::nspecies;
+  constexpr int NP = M::nparams > 0 ? M::nparams : 1;
+  static_assert(NS >= 1 && NS <= detail::kMaxSpecies, "reaction_row: 1..8 species");
+  double p[NP] = {};
+  if constexpr (!FieldParams)
+    for (int q = 0; q < M::nparams; ++q)
+      p[q] = pconst[q];
+  CellSolve acc{0, 0.0, true};
+  for (int i = 0; i < n; ++i) {
+    double uc[NS], a[NS], b[NS], v[NS];
+    if constexpr (FieldParams)
+      for (int q = 0; q < M::nparams; ++q)
+        p[q] = prow[q][i];
+    for (int s = 0; s < NS; ++s) {
+      uc[s] = u[s][i];
+      if (S0) a[s] = S0[s][i];
+      if (S1) b[s] = S1[s][i];
+    }
+    const CellSolve cs =
+        reaction_cell<M>(scheme, uc, p, S0 ? a : nullptr, S1 ? b : nullptr, dt, tol, maxit, v);
+    if (!cs.converged) {
+      if (worst) *worst = cs;
+      return i;
+    }
+    if (cs.iterations > acc.iterations) acc.iterations = cs.iterations;
+    if (cs.residual > acc.residual) acc.residual = cs.residual;
+    for (int s = 0; s < NS; ++s)
+      out[s][i] = v[s] > floor[s] ? v[s] : floor[s];
+  }
+  if (worst) *worst = acc;
+  return -1;
+}
+
+} // namespace morphogen

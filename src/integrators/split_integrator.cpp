@@ -1,0 +1,148 @@
+#include "integrators/split_integrator.hpp"
+
+#include "core/collective_error.hpp"
+#include "core/log_events.hpp"
+#include "core/options.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace morphogen {
+
+SplitIntegrator::SplitIntegrator(const Grid& grid, ReactionRowFn fn,
+                                 const std::vector<std::string>& species, const ParamSet& params,
+                                 std::vector<double> floor, SourceTerms* sources,
+                                 DiffusionSolver& diffusion, const SplitSettings& settings)
+    : grid_(grid), fn_(fn), species_(species), params_(params), floor_(std::move(floor)),
+      sources_(sources), diffusion_(diffusion), set_(settings) {
+  const size_t row = static_cast<size_t>(grid.owned().m[0]);
+  if (params_.any_field())
+    for (size_t q = 0; q < params_.scalar.size(); ++q)
+      const_rows_.emplace_back(params_.field[q].get() ? 0 : row, params_.scalar[q]);
+  row_out_.assign(species.size(), std::vector<double>(row));
+  global_ = grid.create_global();
+}
+
+void SplitIntegrator::react(std::vector<VecH>& u, double t0, double dt, PetscInt step) {
+  LogScope log_scope(log_events().reaction);
+  const int ns = static_cast<int>(species_.size());
+  const int np = static_cast<int>(params_.scalar.size());
+  std::vector<PetscScalar*> a(ns);
+  for (int s = 0; s < ns; ++s)
+    MG_PETSC(VecGetArray(u[s], &a[s]));
+  std::vector<const PetscScalar*> pf(np, nullptr);
+  for (int q = 0; q < np; ++q)
+    if (params_.field[q].get()) MG_PETSC(VecGetArrayRead(params_.field[q], &pf[q]));
+  std::vector<const double*> S0(ns, nullptr), S1(ns, nullptr);
+  bool any_source = false;
+  if (sources_ && sources_->any())
+    for (int s = 0; s < ns; ++s) {
+      S0[s] = sources_->at(s, t0, 0);
+      S1[s] = sources_->at(s, t0 + dt, 1);
+      any_source |= S0[s] != nullptr;
+    }
+  // Rows of zeros stand in for species without a source when others have one.
+  std::vector<double> zeros(any_source ? static_cast<size_t>(grid_.owned().m[0]) : 0, 0.0);
+
+  const Box& ob = grid_.owned();
+  std::vector<const double*> in(ns), prow(np), s0(ns), s1(ns);
+  std::vector<double*> out(ns);
+  for (int s = 0; s < ns; ++s)
+    out[s] = row_out_[s].data();
+  std::string err;
+  int worst_its = 0;
+  for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2] && err.empty(); ++k)
+    for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1] && err.empty(); ++j) {
+      const PetscInt c = grid_.local_index(ob.s[0], j, k);
+      const PetscInt o = grid_.owned_index(ob.s[0], j, k);
+      for (int s = 0; s < ns; ++s) {
+        in[s] = a[s] + c;
+        s0[s] = S0[s] ? S0[s] + o : zeros.data();
+        s1[s] = S1[s] ? S1[s] + o : zeros.data();
+      }
+      for (int q = 0; q < np; ++q)
+        prow[q] = pf[q] ? pf[q] + o : const_rows_.empty() ? nullptr : const_rows_[q].data();
+      CellSolve worst{};
+      const int bad = fn_(set_.reaction, static_cast<int>(ob.m[0]), in.data(), prow.data(),
+                          params_.scalar.data(), any_source ? s0.data() : nullptr,
+                          any_source ? s1.data() : nullptr, dt, set_.newton_tol, set_.newton_max_it,
+                          floor_.data(), out.data(), &worst);
+      if (bad >= 0) {
+        std::ostringstream m;
+        m.precision(17);
+        m << "reaction solve failed at cell (" << ob.s[0] + bad << "," << j << "," << k
+          << ") at step " << step << " (t = " << t0 << "): values";
+        for (int s = 0; s < ns; ++s)
+          m << " " << species_[s] << " = " << in[s][bad];
+        m << ", residual " << worst.residual << " after " << worst.iterations
+          << " Newton iterations; reduce -dt or raise -split_newton_max_it";
+        err = m.str();
+        break;
+      }
+      worst_its = std::max(worst_its, worst.iterations);
+      for (int s = 0; s < ns; ++s)
+        std::copy(out[s], out[s] + ob.m[0], a[s] + c);
+    }
+  for (int q = 0; q < np; ++q)
+    if (pf[q]) MG_PETSC(VecRestoreArrayRead(params_.field[q], &pf[q]));
+  for (int s = 0; s < ns; ++s)
+    MG_PETSC(VecRestoreArray(u[s], &a[s]));
+  last_its_ = worst_its;
+  throw_if_any(grid_.comm(), err);
+}
+
+void SplitIntegrator::diffuse(std::vector<VecH>& u, double dt, PetscInt step) {
+  // Owned cells move between the ghosted local state and the solver's global vector row by
+  // row (the solve needs no ghosts; DMLocalToGlobal does not support every periodic layout).
+  const Box& ob = grid_.owned();
+  for (size_t s = 0; s < u.size(); ++s) {
+    for (int dir = 0; dir < 2; ++dir) {
+      PetscScalar *l, *g;
+      MG_PETSC(VecGetArray(u[s], &l));
+      MG_PETSC(VecGetArray(global_, &g));
+      for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
+        for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j) {
+          double* lr = l + grid_.local_index(ob.s[0], j, k);
+          double* gr = g + grid_.owned_index(ob.s[0], j, k);
+          if (dir == 0)
+            std::copy(lr, lr + ob.m[0], gr);
+          else
+            std::copy(gr, gr + ob.m[0], lr);
+        }
+      MG_PETSC(VecRestoreArray(global_, &g));
+      MG_PETSC(VecRestoreArray(u[s], &l));
+      if (dir == 0) diffusion_.solve(static_cast<int>(s), global_, dt, set_.theta, step);
+    }
+  }
+}
+
+void SplitIntegrator::apply_floor(std::vector<VecH>& u) {
+  const Box& ob = grid_.owned();
+  for (size_t s = 0; s < u.size(); ++s) {
+    if (!std::isfinite(floor_[s])) continue;
+    PetscScalar* a;
+    MG_PETSC(VecGetArray(u[s], &a));
+    for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
+      for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j) {
+        double* r = a + grid_.local_index(ob.s[0], j, k);
+        for (PetscInt i = 0; i < ob.m[0]; ++i)
+          r[i] = std::max(r[i], floor_[s]);
+      }
+    MG_PETSC(VecRestoreArray(u[s], &a));
+  }
+}
+
+void SplitIntegrator::step(std::vector<VecH>& u, double t, double dt, PetscInt step) {
+  if (set_.ordering == SplitOrdering::Lie) {
+    react(u, t, dt, step);
+    diffuse(u, dt, step);
+  } else {
+    react(u, t, 0.5 * dt, step);
+    diffuse(u, dt, step);
+    react(u, t + 0.5 * dt, 0.5 * dt, step);
+  }
+  apply_floor(u);
+}
+
+} // namespace morphogen
