@@ -8,16 +8,6 @@
 
 namespace morphogen {
 
-namespace {
-
-// A neighbour value as a linear combination of in-domain cells plus a constant.
-struct Term {
-  PetscInt c[3];
-  double coef;
-};
-
-} // namespace
-
 DiffusionSolver::DiffusionSolver(const Grid& grid, const Halo& halo, const Stencil& stencil,
                                  const std::vector<std::string>& species,
                                  const std::vector<double>& D,
@@ -29,12 +19,10 @@ DiffusionSolver::DiffusionSolver(const Grid& grid, const Halo& halo, const Stenc
   assembled_dt_.assign(ns, -1.0);
   assembled_theta_.assign(ns, -1.0);
   iterations_.assign(ns, 0);
-  for (size_t s = 0; s < ns; ++s)
-    b_.push_back(grid.create_global());
   rhs_ = grid.create_global();
   tmp_ = grid.create_global();
   has_dirichlet_ = dirichlet != nullptr && !dirichlet->empty();
-  assemble_laplacian(stencil, dirichlet);
+  lap_ = std::make_unique<LaplacianMatrix>(grid, halo, stencil, static_cast<int>(ns), dirichlet);
   // Defaults of our KSP prefix, overridable from the options database.
   int size = 1;
   MPI_Comm_size(grid.comm(), &size);
@@ -53,81 +41,6 @@ DiffusionSolver::~DiffusionSolver() {
     if (k) (void)KSPDestroy(&k);
   for (auto& a : A_)
     if (a) (void)MatDestroy(&a);
-  if (L_) (void)MatDestroy(&L_);
-}
-
-void DiffusionSolver::assemble_laplacian(const Stencil& stencil,
-                                         const std::vector<FaceValues>* dirichlet) {
-  const GridSpec& g = grid_.spec();
-  DM dm = grid_.dm();
-  MG_PETSC(DMSetMatType(dm, MATAIJ));
-  MG_PETSC(DMCreateMatrix(dm, &L_));
-  MG_PETSC(MatSetOption(L_, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE));
-  const size_t ns = species_.size();
-  std::vector<PetscScalar*> barr(ns);
-  for (size_t s = 0; s < ns; ++s)
-    MG_PETSC(VecGetArray(b_[s], &barr[s]));
-  const Box& ob = grid_.owned();
-  // Resolve a stencil neighbour q (global indices, possibly outside the domain) into in-domain
-  // cells; Dirichlet constants (2 g per species) accumulate into consts with sign `sign`.
-  std::vector<double> consts(ns);
-  std::vector<Term> terms;
-  // q is unwrapped (a position in this rank's ghosted box); as in Halo::fill_boundaries, the
-  // highest non-periodic axis on which q is outside decides, recursively.
-  auto resolve = [&](auto&& self, PetscInt qi, PetscInt qj, PetscInt qk, double coef) -> void {
-    const PetscInt q[3] = {qi, qj, qk};
-    int dd = -1;
-    for (int d = 0; d < grid_.dim(); ++d)
-      if (g.bc[d] != Boundary::Periodic && (q[d] < 0 || q[d] >= g.n[d])) dd = d;
-    if (dd < 0) {
-      // Periodic coordinates stay unwrapped: MatSetValuesStencil maps ghost positions of
-      // this rank's ghosted box through the DMDA's periodic numbering.
-      terms.push_back({{q[0], q[1], q[2]}, coef});
-      return;
-    }
-    const int side = q[dd] < 0 ? 0 : 1;
-    PetscInt m[3] = {q[0], q[1], q[2]};
-    m[dd] = side == 0 ? -q[dd] - 1 : 2 * g.n[dd] - 1 - q[dd];
-    if (g.bc[dd] == Boundary::Dirichlet) {
-      for (size_t s = 0; s < ns; ++s)
-        consts[s] += coef * 2.0 *
-                     (*dirichlet)[s].face[2 * dd + side][halo_.face_index(dd, q[0], q[1], q[2])];
-      self(self, m[0], m[1], m[2], -coef);
-    } else {
-      self(self, m[0], m[1], m[2], coef);
-    }
-  };
-  std::vector<MatStencil> cols;
-  std::vector<PetscScalar> vals;
-  for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
-    for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j)
-      for (PetscInt i = ob.s[0]; i < ob.s[0] + ob.m[0]; ++i) {
-        terms.clear();
-        std::fill(consts.begin(), consts.end(), 0.0);
-        for (int t = 0; t < stencil.nterms; ++t) {
-          const PetscInt qi = i + stencil.off[t][0], qj = j + stencil.off[t][1],
-                         qk = k + stencil.off[t][2];
-          resolve(resolve, qi, qj, qk, stencil.w[t]);
-        }
-        MatStencil row{};
-        row.i = i, row.j = j, row.k = k;
-        cols.clear();
-        vals.clear();
-        for (const Term& tm : terms) {
-          MatStencil c{};
-          c.i = tm.c[0], c.j = tm.c[1], c.k = tm.c[2];
-          cols.push_back(c);
-          vals.push_back(tm.coef);
-        }
-        MG_PETSC(MatSetValuesStencil(L_, 1, &row, static_cast<PetscInt>(cols.size()), cols.data(),
-                                     vals.data(), ADD_VALUES));
-        for (size_t s = 0; s < ns; ++s)
-          barr[s][grid_.owned_index(i, j, k)] = consts[s];
-      }
-  MG_PETSC(MatAssemblyBegin(L_, MAT_FINAL_ASSEMBLY));
-  MG_PETSC(MatAssemblyEnd(L_, MAT_FINAL_ASSEMBLY));
-  for (size_t s = 0; s < ns; ++s)
-    MG_PETSC(VecRestoreArray(b_[s], &barr[s]));
 }
 
 void DiffusionSolver::configure(int s) {
@@ -156,7 +69,7 @@ void DiffusionSolver::solve(int s, Vec u, double dt, double theta, PetscInt step
   const double c = dt * D_[s];
   if (assembled_dt_[s] != dt || assembled_theta_[s] != theta) {
     if (A_[s]) MG_PETSC(MatDestroy(&A_[s]));
-    MG_PETSC(MatDuplicate(L_, MAT_COPY_VALUES, &A_[s]));
+    MG_PETSC(MatDuplicate(lap_->L(), MAT_COPY_VALUES, &A_[s]));
     MG_PETSC(MatScale(A_[s], -theta * c));
     MG_PETSC(MatShift(A_[s], 1.0));
     MG_PETSC(KSPSetOperators(ksp_[s], A_[s], A_[s]));
@@ -185,10 +98,10 @@ void DiffusionSolver::solve(int s, Vec u, double dt, double theta, PetscInt step
   // rhs = u + (1 - theta) c L u + c b
   MG_PETSC(VecCopy(u, rhs_));
   if (theta != 1.0) {
-    MG_PETSC(MatMult(L_, u, tmp_));
+    MG_PETSC(MatMult(lap_->L(), u, tmp_));
     MG_PETSC(VecAXPY(rhs_, (1.0 - theta) * c, tmp_));
   }
-  if (has_dirichlet_) MG_PETSC(VecAXPY(rhs_, c, b_[s]));
+  if (has_dirichlet_) MG_PETSC(VecAXPY(rhs_, c, lap_->b(s)));
   MG_PETSC(KSPSolve(ksp_[s], rhs_, u));
   KSPConvergedReason reason;
   MG_PETSC(KSPGetConvergedReason(ksp_[s], &reason));

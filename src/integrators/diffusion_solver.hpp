@@ -18,8 +18,10 @@
 
 #include "core/options.hpp"
 #include "grid/halo.hpp"
+#include "operators/laplacian_matrix.hpp"
 #include "operators/stencil.hpp"
 
+#include <memory>
 #include <petscksp.h>
 #include <string>
 #include <vector>
@@ -40,22 +42,18 @@ public:
 
   PetscInt last_iterations(int s) const { return iterations_[s]; }
   PetscInt total_iterations() const { return total_its_; }
-  Mat laplacian() const { return L_; }
-  // b_s (boundary constants; zero without Dirichlet axes).
-  Vec boundary_vector(int s) const { return b_[s]; }
+  const LaplacianMatrix& laplacian() const { return *lap_; }
 
 private:
-  void assemble_laplacian(const Stencil& stencil, const std::vector<FaceValues>* dirichlet);
   void configure(int s);
 
   const Grid& grid_;
   const Halo& halo_;
   std::vector<std::string> species_;
   std::vector<double> D_;
-  Mat L_ = nullptr;
+  std::unique_ptr<LaplacianMatrix> lap_;
   std::vector<Mat> A_;
   std::vector<KSP> ksp_;
-  std::vector<VecH> b_;
   std::vector<double> assembled_dt_, assembled_theta_;
   std::vector<PetscInt> iterations_;
   PetscInt total_its_ = 0;
