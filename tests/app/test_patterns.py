@@ -27,3 +27,26 @@ def test_stripes_deck_forms_stripes(workdir):
     d = describe(str(workdir / "stripes" / "a_final.png"))
     assert d["contrast"] > 0.3, d
     assert d["median_elongation"] > 2.5 or d["largest_fraction"] > 0.05, d
+
+
+def test_split_with_ten_times_the_explicit_bound_forms_the_same_spots(workdir):
+    """Sanderson Fig. 1 at 128^2: explicit (dt 0.5, 50,000 steps) against the split integrator
+    with dt 10 = 10x the explicit bound (2,500 steps, same final time t = 25,000): both form
+    spots, and the dominant wavelengths agree within 5 %."""
+    import sys
+
+    sys.path.insert(0, os.path.join(SOURCE, "postproc"))
+    from wavelength import dominant_wavelength
+
+    common = ["-grid_n", "128,128", "-png_every", "0", "-png_species", "a"]
+    ex = run(common + ["-output_dir", str(workdir / "explicit")], cwd=workdir, ranks=2)
+    assert ex.returncode == 0, ex.stderr
+    sp = run(common + ["-integrator", "split", "-dt", "10", "-steps", "2500",
+                       "-output_dir", str(workdir / "split")], cwd=workdir, ranks=2, timeout=600)
+    assert sp.returncode == 0, sp.stderr
+    lam_ex, _ = dominant_wavelength(str(workdir / "explicit" / "a_final.png"))
+    lam_sp, _ = dominant_wavelength(str(workdir / "split" / "a_final.png"))
+    print(f"dominant wavelength: explicit {lam_ex:.3f}, split dt=10 {lam_sp:.3f}")
+    assert abs(lam_sp - lam_ex) / lam_ex < 0.05
+    d = describe(str(workdir / "split" / "a_final.png"))
+    assert d["count"] > 25 and d["median_elongation"] < 1.6, d
