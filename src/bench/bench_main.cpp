@@ -84,12 +84,56 @@ Result bench_explicit(MPI_Comm comm, Options& opt, const std::string& n, int ste
   return r;
 }
 
+// One split step (Strang: trapezoidal implicit reaction, Crank-Nicolson diffusion) of Turing
+// Fig. 1 at 1024^2 with dt = 10x the explicit bound, for one diffusion preconditioner.
+struct SplitResult {
+  double seconds_per_step = 0, its_per_solve = 0;
+};
+
+SplitResult bench_split(MPI_Comm comm, Options& opt,
+                        const std::vector<std::pair<std::string, std::string>>& pc, int steps) {
+  static const char* const keys[] = {"-diffusion_pc_type", "-diffusion_pc_mg_levels",
+                                     "-diffusion_pc_mg_galerkin", "-diffusion_pc_hypre_type"};
+  for (const char* k : keys)
+    MG_PETSC(PetscOptionsClearValue(nullptr, k));
+  const std::pair<const char*, const char*> base[] = {{"-model", "turing"},
+                                                      {"-grid_n", "1024,1024"},
+                                                      {"-grid_L", "1024"},
+                                                      {"-init_a", "4"},
+                                                      {"-init_b", "4"},
+                                                      {"-params_alpha", "12 +- 0.1% gauss"},
+                                                      {"-params_beta", "16 +- 0.1% gauss"},
+                                                      {"-integrator", "split"},
+                                                      {"-dt", "10"}};
+  for (auto& [k, v] : base)
+    MG_PETSC(PetscOptionsSetValue(nullptr, k, v));
+  for (auto& [k, v] : pc)
+    MG_PETSC(PetscOptionsSetValue(nullptr, k.c_str(), v.c_str()));
+  Simulation sim(comm, opt, "");
+  sim.step(); // assembles the matrices and sets up the preconditioners
+  const PetscInt its0 = sim.diffusion_solver()->total_iterations();
+  MPI_Barrier(comm);
+  const double t0 = MPI_Wtime();
+  for (int i = 0; i < steps; ++i)
+    sim.step();
+  MPI_Barrier(comm);
+  SplitResult r;
+  r.seconds_per_step = (MPI_Wtime() - t0) / steps;
+  r.its_per_solve =
+      static_cast<double>(sim.diffusion_solver()->total_iterations() - its0) / (2.0 * steps);
+  return r;
+}
+
 int run(MPI_Comm comm) {
   int size = 1;
   MPI_Comm_size(comm, &size);
   Options opt(comm);
   const PetscInt steps2 = opt.integer("bench_steps_2d", 200, 1, 1000000, "timed steps at 1024^2");
   const PetscInt steps3 = opt.integer("bench_steps_3d", 50, 1, 1000000, "timed steps at 128^3");
+  const bool with_split =
+      opt.flag("bench_split", true, "also time the split integrator (CN + implicit reaction)");
+  const PetscInt split_steps =
+      opt.integer("bench_steps_split", 5, 1, 100000, "timed split steps per preconditioner");
   const PetscInt mb =
       opt.integer("bench_stream_mb", 256, 8, 65536, "STREAM array size per rank, MiB");
   const double bw = stream_triad(comm, static_cast<size_t>(mb) * 1024 * 1024 / 8, 10);
@@ -109,6 +153,27 @@ int run(MPI_Comm comm) {
   report("2d", "1024x1024", r2);
   const Result r3 = bench_explicit(comm, opt, "128,128,128", static_cast<int>(steps3));
   report("3d", "128x128x128", r3);
+  if (with_split) {
+    // The explicit step for comparison: same model and grid as the split runs.
+    const double explicit_s = 1024.0 * 1024.0 / r2.cups;
+    PetscPrintf(comm, "split_1024x1024 explicit_step_s=%.4f (Gray-Scott above)\n", explicit_s);
+    const std::vector<std::pair<std::string, std::vector<std::pair<std::string, std::string>>>>
+        pcs = {{"icc", {}},
+               {"mg",
+                {{"-diffusion_pc_type", "mg"},
+                 {"-diffusion_pc_mg_levels", "5"},
+                 {"-diffusion_pc_mg_galerkin", "both"}}},
+               {"hypre",
+                {{"-diffusion_pc_type", "hypre"}, {"-diffusion_pc_hypre_type", "boomeramg"}}}};
+    for (const auto& [name, pc] : pcs) {
+      const SplitResult sr = bench_split(comm, opt, pc, static_cast<int>(split_steps));
+      PetscPrintf(comm,
+                  "split_1024x1024 pc=%s seconds_per_step=%.4f ksp_its_per_solve=%.1f "
+                  "cost_vs_explicit_step=%.1f\n",
+                  name.c_str(), sr.seconds_per_step, sr.its_per_solve,
+                  sr.seconds_per_step / explicit_s);
+    }
+  }
   PetscPrintf(comm, "roofline_fraction=%.3f\n", r2.cups / roof);
   return 0;
 }
