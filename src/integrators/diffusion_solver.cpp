@@ -43,6 +43,23 @@ DiffusionSolver::~DiffusionSolver() {
     if (a) (void)MatDestroy(&a);
 }
 
+namespace {
+
+void check_type_name(const char* option, PetscFunctionList list, const char* what) {
+  char value[256];
+  PetscBool set = PETSC_FALSE;
+  MG_PETSC(PetscOptionsGetString(nullptr, nullptr, (std::string("-") + option).c_str(), value,
+                                 sizeof value, &set));
+  if (!set) return;
+  void (*fn)(void) = nullptr;
+  MG_PETSC(PetscFunctionListFind(list, value, &fn));
+  if (fn) return;
+  throw UserError(std::string("-") + option + " " + value + ": unknown " + what +
+                  " type (this PETSc's types are listed by -help with -integrator split)");
+}
+
+} // namespace
+
 void DiffusionSolver::configure(int s) {
   int size = 1;
   MPI_Comm_size(grid_.comm(), &size);
@@ -58,6 +75,14 @@ void DiffusionSolver::configure(int s) {
   MG_PETSC(KSPSetDM(ksp, grid_.dm()));
   MG_PETSC(KSPSetDMActive(ksp, PETSC_FALSE));
   MG_PETSC(KSPSetInitialGuessNonzero(ksp, PETSC_TRUE));
+  // User options are applied now, at setup, so that a bad -diffusion_* value fails before any
+  // output is written; unknown KSP/PC type names are reported with the registered ones.
+  check_type_name("diffusion_ksp_type", KSPList, "KSP");
+  check_type_name("diffusion_pc_type", PCList, "PC");
+  const std::string err = petsc_quietly([&] { return KSPSetFromOptions(ksp); });
+  if (!err.empty())
+    throw UserError("-diffusion_ksp_*/-diffusion_pc_* options: PETSc refused them (" + err +
+                    "); see -help for the KSP and PC types");
 }
 
 void DiffusionSolver::solve(int s, Vec u, double dt, double theta, PetscInt step) {
@@ -74,7 +99,6 @@ void DiffusionSolver::solve(int s, Vec u, double dt, double theta, PetscInt step
     MG_PETSC(MatShift(A_[s], 1.0));
     MG_PETSC(KSPSetOperators(ksp_[s], A_[s], A_[s]));
     if (assembled_dt_[s] < 0) {
-      MG_PETSC(KSPSetFromOptions(ksp_[s]));
       PC pc;
       MG_PETSC(KSPGetPC(ksp_[s], &pc));
       PetscBool bj = PETSC_FALSE, user_sub = PETSC_FALSE;

@@ -33,6 +33,15 @@ CASES = [
     ("param_of_other_model", ["-params_F", "0.03"], ["-params_F", "unknown option"]),
     ("diverged", ["-clamp", "false", "-params_s", "5", "-steps", "3000", "-png_every", "0"],
      ["became", "by step", "reduce -dt"]),
+    ("split_ordering", ["-integrator", "split", "-split_ordering", "lei"], ["-split_ordering", "lei", "did you mean lie"]),
+    ("split_reaction", ["-integrator", "split", "-split_reaction", "rk4"], ["-split_reaction", "rk4", "allowed euler"]),
+    ("bad_pc_type", ["-integrator", "split", "-diffusion_pc_type", "nonsense"], ["-diffusion_pc_type nonsense: unknown PC type"]),
+    ("ksp_diverged", ["-grid_n", "64,64", "-integrator", "split", "-dt", "10", "-diffusion_ksp_max_it", "1", "-steps", "3"],
+     ["diffusion solve of species", "DIVERGED_ITS", "after 1 iterations", "at step 1"]),
+    ("newton_failed", ["-grid_n", "64,64", "-integrator", "split", "-dt", "1000", "-split_newton_max_it", "1",
+                       "-split_newton_tol", "1e-14", "-steps", "3"],
+     ["reaction solve failed at cell", "residual", "Newton iterations"]),
+    ("explicit_dt_suggests_split", ["-dt", "5"], ["-dt 5", "-integrator split"]),
 ]
 
 
@@ -64,7 +73,7 @@ def test_bad_input(case, ranks, workdir):
     assert lines[0].startswith("morphogen: error: "), lines[0]
     for n in needles:
         assert n in lines[0], lines[0]
-    if case[0] != "diverged":
+    if case[0] not in ("diverged", "ksp_diverged", "newton_failed"):
         assert sorted(os.listdir(out)) == ["a_final.png"]
     assert sentinel.read_text() == "previous result"
 
