@@ -212,15 +212,18 @@ void Simulation::read_model(Options& opt, const std::string& base_dir) {
 
 void Simulation::read_time(Options& opt) {
   const std::string kind =
-      opt.choice("integrator", "explicit", {"explicit", "split"},
-                 "time integrator: explicit (forward Euler, diffusion and reaction fused) or split "
-                 "(Lie/Strang splitting, implicit diffusion by KSP, per-cell reaction by Newton)");
+      opt.choice("integrator", "explicit", {"explicit", "split", "ts"},
+                 "time integrator: explicit (forward Euler, diffusion and reaction fused), "
+                 "split (Lie/Strang splitting, implicit diffusion by KSP, per-cell reaction by "
+                 "Newton) or ts (PETSc TS, ARKIMEX 2E: diffusion implicit, reaction explicit; "
+                 "every -ts_ option)");
   split_ = kind == "split";
+  ts_ = kind == "ts";
   stable_dt_ = ExplicitIntegrator::stable_dt(stencil_, D_);
   const double def_dt = std::isfinite(stable_dt_) ? 0.9 * stable_dt_ : 1.0;
   dt_ = opt.real("dt", def_dt, 0.0, kInf, "time step");
   if (!(dt_ > 0)) throw UserError("-dt " + format_double(dt_) + ": must be > 0");
-  if (!split_) {
+  if (!split_ && !ts_) {
     const bool force = opt.flag("force_dt", false,
                                 "run even when -dt exceeds the explicit diffusion stability bound");
     if (dt_ > stable_dt_ && !force)
@@ -234,6 +237,16 @@ void Simulation::read_time(Options& opt) {
   steps_ =
       opt.integer("steps", 1000, 0, std::numeric_limits<PetscInt>::max(), "number of time steps");
   sources_ = std::make_unique<SourceTerms>(*grid_, opt, species_, seed_, base_dir_);
+  if (ts_) {
+    for (const char* k :
+         {"ts_type", "ts_arkimex_type", "ts_adapt_type", "ts_rtol", "ts_atol", "ts_monitor",
+          "snes_type", "ksp_type", "pc_type", "sub_pc_type", "ksp_rtol"})
+      opt.known(k);
+    laplacian_ = std::make_unique<LaplacianMatrix>(*grid_, *halo_, stencil_, model_->nspecies,
+                                                   dirichlet_.empty() ? nullptr : &dirichlet_);
+    ts_integrator_ = std::make_unique<TsIntegrator>(*grid_, model_->rates, species_, params_, D_,
+                                                    floor_, *laplacian_, sources_.get(), dt_);
+  }
   if (split_) {
     SplitSettings set;
     const std::string ord = opt.choice("split_ordering", "strang", {"lie", "strang"},
@@ -309,6 +322,8 @@ void Simulation::read_output(Options& opt) {
 void Simulation::step() {
   if (split_) {
     split_integrator_->step(u_, t_, dt_, step_ + 1);
+  } else if (ts_) {
+    ts_integrator_->step(u_, t_, dt_, step_ + 1);
   } else {
     integrator_->step(u_, work_, dt_);
     if (sources_->any()) add_sources(t_);

@@ -11,6 +11,7 @@
 #include "integrators/diffusion_solver.hpp"
 #include "integrators/explicit_integrator.hpp"
 #include "integrators/split_integrator.hpp"
+#include "integrators/ts_integrator.hpp"
 
 #include <memory>
 #include <string>
@@ -79,7 +80,9 @@ private:
   std::unique_ptr<SourceTerms> sources_;
   std::unique_ptr<DiffusionSolver> diffusion_;
   std::unique_ptr<SplitIntegrator> split_integrator_;
-  bool split_ = false;
+  std::unique_ptr<LaplacianMatrix> laplacian_; // TS only; before ts_integrator_ (destroyed after)
+  std::unique_ptr<TsIntegrator> ts_integrator_;
+  bool split_ = false, ts_ = false;
   std::uint64_t seed_ = 1;
   double dt_ = 0, stable_dt_ = 0, t_ = 0;
   PetscInt steps_ = 0, step_ = 0;

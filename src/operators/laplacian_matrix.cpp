@@ -53,8 +53,8 @@ LaplacianMatrix::LaplacianMatrix(const Grid& grid, const Halo& halo, const Stenc
     m[dd] = side == 0 ? -q[dd] - 1 : 2 * g.n[dd] - 1 - q[dd];
     if (g.bc[dd] == Boundary::Dirichlet) {
       for (size_t s = 0; s < ns; ++s)
-        consts[s] += coef * 2.0 *
-                     (*dirichlet)[s].face[2 * dd + side][halo.face_index(dd, q[0], q[1], q[2])];
+        consts[s] +=
+            coef * 2.0 * (*dirichlet)[s].face[2 * dd + side][halo.face_index(dd, q[0], q[1], q[2])];
       self(self, m[0], m[1], m[2], -coef);
     } else {
       self(self, m[0], m[1], m[2], coef);

@@ -1,0 +1,476 @@
+#include "integrators/ts_integrator.hpp"
+
+#include "core/log_events.hpp"
+#include "core/user_error.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <stdexcept>
+
+namespace morphogen {
+
+namespace {
+
+// Restores PETSc's previous error handler on scope exit (exception-safe).
+struct QuietPetscErrors {
+  QuietPetscErrors() { (void)PetscPushErrorHandler(PetscReturnErrorHandler, nullptr); }
+  ~QuietPetscErrors() { (void)PetscPopErrorHandler(); }
+  QuietPetscErrors(const QuietPetscErrors&) = delete;
+  QuietPetscErrors& operator=(const QuietPetscErrors&) = delete;
+};
+
+} // namespace
+
+TsIntegrator::TsIntegrator(const Grid& grid, RatesFn rates, const std::vector<std::string>& species,
+                           const ParamSet& params, const std::vector<double>& D,
+                           std::vector<double> floor, const LaplacianMatrix& lap,
+                           SourceTerms* sources, double dt)
+    : grid_(grid), rates_(rates), species_(species), params_(params), D_(D),
+      floor_(std::move(floor)), lap_(lap), sources_(sources) {
+  ns_ = static_cast<PetscInt>(species.size());
+  nloc_ = grid.owned().size();
+  if (D_.size() != species.size() || floor_.size() != species.size() ||
+      params_.scalar.size() != params_.field.size() || !rates_)
+    throw std::logic_error("TsIntegrator: species, D, floor or parameter sizes disagree");
+  cell_u_.assign(species.size(), 0.0);
+  cell_r_.assign(species.size(), 0.0);
+  cell_p_.assign(params_.scalar.size(), 0.0);
+  try {
+    build_operator();
+    setup_ts(dt);
+  } catch (...) {
+    if (ts_) (void)TSDestroy(&ts_);
+    if (J_) (void)MatDestroy(&J_);
+    if (Dblock_) (void)MatDestroy(&Dblock_);
+    throw;
+  }
+}
+
+TsIntegrator::~TsIntegrator() {
+  if (ts_) (void)TSDestroy(&ts_);
+  if (J_) (void)MatDestroy(&J_);
+  if (Dblock_) (void)MatDestroy(&Dblock_);
+}
+
+// blockdiag(D_s L) in the block layout, the block Dirichlet vector and the block state.
+void TsIntegrator::build_operator() {
+  MPI_Comm comm = grid_.comm();
+  int size = 1, rank = 0;
+  MPI_Comm_size(comm, &size);
+  MPI_Comm_rank(comm, &rank);
+  // Ownership ranges of the DMDA's global (PETSc-ordered) vectors: L's row/column numbering.
+  std::vector<PetscInt> ranges(static_cast<size_t>(size) + 1);
+  {
+    VecH g = grid_.create_global();
+    const PetscInt* r = nullptr;
+    MG_PETSC(VecGetOwnershipRanges(g, &r));
+    std::copy(r, r + size + 1, ranges.begin());
+  }
+  const PetscInt rstart = ranges[rank], rend = ranges[rank + 1];
+  if (rend - rstart != nloc_) throw std::logic_error("TsIntegrator: DMDA ownership mismatch");
+  const PetscInt nb = ns_ * nloc_, bstart = ns_ * rstart;
+  // DMDA global index g owned by rank r -> index of species s in the block layout.
+  auto block_col = [&](PetscInt g, PetscInt s) {
+    const auto r = std::upper_bound(ranges.begin(), ranges.end(), g) - ranges.begin() - 1;
+    return ns_ * ranges[r] + s * (ranges[r + 1] - ranges[r]) + (g - ranges[r]);
+  };
+
+  Mat L = lap_.L();
+  std::vector<PetscInt> dnz(static_cast<size_t>(nb)), onz(static_cast<size_t>(nb));
+  for (PetscInt g = rstart; g < rend; ++g) {
+    PetscInt nc = 0;
+    const PetscInt* cols = nullptr;
+    MG_PETSC(MatGetRow(L, g, &nc, &cols, nullptr));
+    PetscInt d = 0;
+    for (PetscInt c = 0; c < nc; ++c)
+      d += cols[c] >= rstart && cols[c] < rend;
+    const PetscInt o = nc - d;
+    MG_PETSC(MatRestoreRow(L, g, &nc, &cols, nullptr)); // (zeroes nc)
+    for (PetscInt s = 0; s < ns_; ++s) {
+      dnz[static_cast<size_t>(s * nloc_ + g - rstart)] = d;
+      onz[static_cast<size_t>(s * nloc_ + g - rstart)] = o;
+    }
+  }
+  MG_PETSC(MatCreate(comm, &Dblock_));
+  MG_PETSC(MatSetSizes(Dblock_, nb, nb, PETSC_DETERMINE, PETSC_DETERMINE));
+  MG_PETSC(MatSetType(Dblock_, MATAIJ));
+  MG_PETSC(MatSeqAIJSetPreallocation(Dblock_, 0, dnz.data()));
+  MG_PETSC(MatMPIAIJSetPreallocation(Dblock_, 0, dnz.data(), 0, onz.data()));
+  std::vector<PetscInt> bcols;
+  std::vector<PetscScalar> bvals;
+  for (PetscInt g = rstart; g < rend; ++g) {
+    PetscInt nc = 0;
+    const PetscInt* cols = nullptr;
+    const PetscScalar* vals = nullptr;
+    MG_PETSC(MatGetRow(L, g, &nc, &cols, &vals));
+    bcols.resize(static_cast<size_t>(nc));
+    bvals.resize(static_cast<size_t>(nc));
+    for (PetscInt s = 0; s < ns_; ++s) {
+      const PetscInt row = bstart + s * nloc_ + (g - rstart);
+      for (PetscInt c = 0; c < nc; ++c) {
+        bcols[static_cast<size_t>(c)] = block_col(cols[c], s);
+        bvals[static_cast<size_t>(c)] = D_[static_cast<size_t>(s)] * vals[c];
+      }
+      // Kept even where D_s = 0: the pattern (with its diagonal) stays that of L.
+      MG_PETSC(MatSetValues(Dblock_, 1, &row, nc, bcols.data(), bvals.data(), INSERT_VALUES));
+    }
+    MG_PETSC(MatRestoreRow(L, g, &nc, &cols, &vals));
+  }
+  MG_PETSC(MatAssemblyBegin(Dblock_, MAT_FINAL_ASSEMBLY));
+  MG_PETSC(MatAssemblyEnd(Dblock_, MAT_FINAL_ASSEMBLY));
+  MG_PETSC(MatDuplicate(Dblock_, MAT_COPY_VALUES, &J_));
+
+  // Block state X and block Dirichlet vector D_s b_s.
+  MG_PETSC(VecCreate(comm, X_.out()));
+  MG_PETSC(VecSetSizes(X_, nb, PETSC_DETERMINE));
+  MG_PETSC(VecSetType(X_, VECSTANDARD));
+  MG_PETSC(VecSet(X_, 0.0));
+  MG_PETSC(VecDuplicate(X_, bD_.out()));
+  PetscScalar* bd = nullptr;
+  MG_PETSC(VecGetArray(bD_, &bd));
+  int local_b = 0;
+  for (PetscInt s = 0; s < ns_; ++s) {
+    const PetscScalar* b = nullptr;
+    MG_PETSC(VecGetArrayRead(lap_.b(static_cast<int>(s)), &b));
+    for (PetscInt c = 0; c < nloc_; ++c) {
+      bd[s * nloc_ + c] = D_[static_cast<size_t>(s)] * b[c];
+      local_b |= bd[s * nloc_ + c] != 0.0;
+    }
+    MG_PETSC(VecRestoreArrayRead(lap_.b(static_cast<int>(s)), &b));
+  }
+  MG_PETSC(VecRestoreArray(bD_, &bd));
+  int any_b = 0;
+  MPI_Allreduce(&local_b, &any_b, 1, MPI_INT, MPI_LOR, comm);
+  has_b_ = any_b != 0;
+}
+
+void TsIntegrator::setup_ts(double dt) {
+  MPI_Comm comm = grid_.comm();
+  int size = 1;
+  MPI_Comm_size(comm, &size);
+  MG_PETSC(TSCreate(comm, &ts_));
+  MG_PETSC(TSSetType(ts_, TSARKIMEX));
+  MG_PETSC(TSARKIMEXSetType(ts_, TSARKIMEX2E));
+  MG_PETSC(TSSetProblemType(ts_, TS_NONLINEAR));
+  MG_PETSC(TSSetIFunction(ts_, nullptr, ifunction_cb, this));
+  MG_PETSC(TSSetRHSFunction(ts_, nullptr, rhsfunction_cb, this));
+  MG_PETSC(TSSetIJacobian(ts_, J_, J_, ijacobian_cb, this));
+  MG_PETSC(TSSetSolution(ts_, X_));
+  MG_PETSC(TSSetTime(ts_, 0.0));
+  MG_PETSC(TSSetTimeStep(ts_, dt));
+  MG_PETSC(TSSetMaxTime(ts_, dt));
+  // The step count runs over the whole integration (TS's default cap is 5000 steps).
+  MG_PETSC(TSSetMaxSteps(ts_, PETSC_MAX_INT));
+  MG_PETSC(TSSetExactFinalTime(ts_, TS_EXACTFINALTIME_MATCHSTEP));
+  // A failed step sets the converged reason (reported by step()) instead of raising an error.
+  MG_PETSC(TSSetErrorIfStepFails(ts_, PETSC_FALSE));
+  TSAdapt adapt;
+  MG_PETSC(TSGetAdapt(ts_, &adapt));
+  MG_PETSC(TSAdaptSetType(adapt, TSADAPTNONE));
+  SNES snes;
+  MG_PETSC(TSGetSNES(ts_, &snes));
+  MG_PETSC(SNESSetType(snes, SNESKSPONLY));
+  KSP ksp;
+  MG_PETSC(SNESGetKSP(snes, &ksp));
+  MG_PETSC(KSPSetType(ksp, KSPCG));
+  PC pc;
+  MG_PETSC(KSPGetPC(ksp, &pc));
+  MG_PETSC(PCSetType(pc, size == 1 ? PCICC : PCBJACOBI));
+  MG_PETSC(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, 10000));
+  MG_PETSC(TSSetFromOptions(ts_));
+
+  TSType type = nullptr;
+  MG_PETSC(TSGetType(ts_, &type));
+  const std::string tname = type ? type : "";
+  for (const char* explicit_type : {TSEULER, TSRK, TSSSP, TSMPRK, TSBASICSYMPLECTIC, TSPSEUDO})
+    if (tname == explicit_type)
+      throw UserError("-ts_type " + tname +
+                      ": an explicit (or pseudo-transient) TS type cannot take the implicit "
+                      "diffusion part; use arkimex (default), rosw, or an implicit type such as "
+                      "bdf, cn, beuler or theta");
+  // ksponly is exact only when the implicit part is the linear diffusion: IMEX schemes. Fully
+  // implicit schemes also put the reaction into the solve, which then needs Newton (with the
+  // diffusion Jacobian only, so it converges linearly at a rate ~ dt |dR/du|).
+  PetscBool fully_implicit = PETSC_FALSE;
+  if (tname == TSARKIMEX) MG_PETSC(TSARKIMEXGetFullyImplicit(ts_, &fully_implicit));
+  const bool imex = (tname == TSARKIMEX && !fully_implicit) || tname == TSROSW || tname == TSEIMEX;
+  PetscBool user_snes = PETSC_FALSE;
+  MG_PETSC(PetscOptionsHasName(nullptr, nullptr, "-snes_type", &user_snes));
+  if (!imex && !user_snes) MG_PETSC(SNESSetType(snes, SNESNEWTONLS));
+
+  MG_PETSC(TSGetAdapt(ts_, &adapt));
+  PetscBool none = PETSC_FALSE;
+  MG_PETSC(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(adapt), TSADAPTNONE, &none));
+  adaptive_ = !none;
+  next_dt_ = dt;
+
+  // Set the linear solver up now, on an operator of the final pattern, so that the parallel
+  // default (ICC blocks) can be installed and every -ksp_/-pc_/-sub_ option is read before the
+  // caller checks for unused options. The values are refreshed by the first IJacobian call.
+  MG_PETSC(TSGetSNES(ts_, &snes));
+  MG_PETSC(SNESGetKSP(snes, &ksp));
+  MG_PETSC(fill_jacobian(1.0 / dt));
+  jac_shift_ = -1; // force a refresh on the first call
+  MG_PETSC(KSPSetOperators(ksp, J_, J_));
+  MG_PETSC(KSPGetPC(ksp, &pc));
+  PetscBool bj = PETSC_FALSE, user_sub = PETSC_FALSE;
+  MG_PETSC(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(pc), PCBJACOBI, &bj));
+  MG_PETSC(PetscOptionsHasName(nullptr, nullptr, "-sub_pc_type", &user_sub));
+  MG_PETSC(KSPSetUp(ksp));
+  if (bj && !user_sub) {
+    PetscInt nblocks = 0, first = 0;
+    KSP* sub = nullptr;
+    MG_PETSC(PCBJacobiGetSubKSP(pc, &nblocks, &first, &sub));
+    for (PetscInt q = 0; q < nblocks; ++q) {
+      PC spc;
+      MG_PETSC(KSPGetPC(sub[q], &spc));
+      MG_PETSC(PCSetType(spc, PCICC));
+    }
+  }
+}
+
+// ---- PETSc callbacks: no exception may leave them -------------------------------------------
+
+PetscErrorCode TsIntegrator::ifunction_cb(TS, PetscReal, Vec X, Vec Xdot, Vec F, void* ctx) {
+  auto* self = static_cast<TsIntegrator*>(ctx);
+  try {
+    return self->ifunction(X, Xdot, F);
+  } catch (...) {
+    self->callback_error_ = std::current_exception();
+    return PETSC_ERR_LIB;
+  }
+}
+
+PetscErrorCode TsIntegrator::rhsfunction_cb(TS, PetscReal t, Vec X, Vec G, void* ctx) {
+  auto* self = static_cast<TsIntegrator*>(ctx);
+  try {
+    return self->rhsfunction(t, X, G);
+  } catch (...) {
+    self->callback_error_ = std::current_exception();
+    return PETSC_ERR_LIB;
+  }
+}
+
+PetscErrorCode TsIntegrator::ijacobian_cb(TS, PetscReal, Vec, Vec, PetscReal shift, Mat A, Mat P,
+                                          void* ctx) {
+  auto* self = static_cast<TsIntegrator*>(ctx);
+  try {
+    return self->ijacobian(shift, A, P);
+  } catch (...) {
+    self->callback_error_ = std::current_exception();
+    return PETSC_ERR_LIB;
+  }
+}
+
+// F(t, X, Xdot) = Xdot - (blockdiag(D_s L) X + D_s b_s)
+PetscErrorCode TsIntegrator::ifunction(Vec X, Vec Xdot, Vec F) {
+  PetscFunctionBeginUser;
+  PetscCall(MatMult(Dblock_, X, F));
+  PetscCall(VecAYPX(F, -1.0, Xdot));
+  if (has_b_) PetscCall(VecAXPY(F, -1.0, bD_));
+  PetscFunctionReturn(0);
+}
+
+// G(t, X) = R(X; p) + S(x, t), cell by cell.
+PetscErrorCode TsIntegrator::rhsfunction(PetscReal t, Vec X, Vec G) {
+  PetscFunctionBeginUser;
+  LogScope log_scope(log_events().reaction);
+  const size_t ns = static_cast<size_t>(ns_), np = params_.scalar.size();
+  // Source values first: their evaluation may throw (a bad expression value), before any array
+  // is taken from PETSc.
+  std::vector<const double*> S(ns, nullptr);
+  if (sources_ && sources_->any())
+    for (size_t s = 0; s < ns; ++s)
+      S[s] = sources_->at(static_cast<int>(s), t, 0);
+  std::vector<const PetscScalar*> pf(np, nullptr);
+  for (size_t q = 0; q < np; ++q)
+    if (params_.field[q].get()) PetscCall(VecGetArrayRead(params_.field[q], &pf[q]));
+  for (size_t q = 0; q < np; ++q)
+    cell_p_[q] = params_.scalar[q];
+  const PetscScalar* x = nullptr;
+  PetscScalar* g = nullptr;
+  PetscCall(VecGetArrayRead(X, &x));
+  PetscCall(VecGetArray(G, &g));
+  double* u = cell_u_.data();
+  double* p = cell_p_.data();
+  double* r = cell_r_.data();
+  for (PetscInt c = 0; c < nloc_; ++c) {
+    for (size_t s = 0; s < ns; ++s)
+      u[s] = x[static_cast<PetscInt>(s) * nloc_ + c];
+    for (size_t q = 0; q < np; ++q)
+      if (pf[q]) p[q] = pf[q][c];
+    rates_(u, p, r);
+    for (size_t s = 0; s < ns; ++s)
+      g[static_cast<PetscInt>(s) * nloc_ + c] = r[s] + (S[s] ? S[s][c] : 0.0);
+  }
+  PetscCall(VecRestoreArray(G, &g));
+  PetscCall(VecRestoreArrayRead(X, &x));
+  for (size_t q = 0; q < np; ++q)
+    if (pf[q]) PetscCall(VecRestoreArrayRead(params_.field[q], &pf[q]));
+  PetscFunctionReturn(0);
+}
+
+// J = shift I - blockdiag(D_s L), refreshed only when the shift changed.
+PetscErrorCode TsIntegrator::fill_jacobian(PetscReal shift) {
+  PetscFunctionBeginUser;
+  PetscCall(MatCopy(Dblock_, J_, SAME_NONZERO_PATTERN));
+  PetscCall(MatScale(J_, -1.0));
+  PetscCall(MatShift(J_, shift));
+  jac_shift_ = shift;
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode TsIntegrator::ijacobian(PetscReal shift, Mat A, Mat P) {
+  PetscFunctionBeginUser;
+  PetscCheck(P == J_, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG,
+             "TsIntegrator: unexpected preconditioning matrix");
+  // Only this class writes J (no RHS Jacobian is registered, so TS never adds to it).
+  if (shift != jac_shift_) PetscCall(fill_jacobian(shift));
+  if (A != P) {
+    PetscCall(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY));
+  }
+  PetscFunctionReturn(0);
+}
+
+// ---- stepping -------------------------------------------------------------------------------
+
+bool TsIntegrator::copy_state(std::vector<VecH>& u, bool to_x) {
+  const Box& ob = grid_.owned();
+  bool changed = false;
+  PetscScalar* x = nullptr;
+  MG_PETSC(VecGetArray(X_, &x));
+  for (PetscInt s = 0; s < ns_; ++s) {
+    PetscScalar* l = nullptr;
+    MG_PETSC(VecGetArray(u[static_cast<size_t>(s)], &l));
+    for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
+      for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j) {
+        double* lr = l + grid_.local_index(ob.s[0], j, k);
+        double* xr = x + s * nloc_ + grid_.owned_index(ob.s[0], j, k);
+        if (to_x) {
+          if (!changed && !std::equal(lr, lr + ob.m[0], xr)) changed = true;
+          std::copy(lr, lr + ob.m[0], xr);
+        } else {
+          std::copy(xr, xr + ob.m[0], lr);
+        }
+      }
+    MG_PETSC(VecRestoreArray(u[static_cast<size_t>(s)], &l));
+  }
+  MG_PETSC(VecRestoreArray(X_, &x));
+  return changed;
+}
+
+void TsIntegrator::apply_floor(std::vector<VecH>& u) {
+  const Box& ob = grid_.owned();
+  for (size_t s = 0; s < u.size(); ++s) {
+    if (!std::isfinite(floor_[s])) continue;
+    PetscScalar* a = nullptr;
+    MG_PETSC(VecGetArray(u[s], &a));
+    for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
+      for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j) {
+        double* r = a + grid_.local_index(ob.s[0], j, k);
+        for (PetscInt i = 0; i < ob.m[0]; ++i)
+          r[i] = std::max(r[i], floor_[s]);
+      }
+    MG_PETSC(VecRestoreArray(u[s], &a));
+  }
+}
+
+void TsIntegrator::step(std::vector<VecH>& u, double t, double dt, PetscInt step) {
+  if (static_cast<PetscInt>(u.size()) != ns_)
+    throw std::logic_error("TsIntegrator::step: wrong number of species vectors");
+  // TS continues from its last solve (multistep schemes such as -ts_type bdf keep their
+  // history) unless the state or the time changed in between (the clamp floor, a restart):
+  // then it restarts the step, without reusing stage or history data.
+  PetscReal tprev = 0;
+  MG_PETSC(TSGetTime(ts_, &tprev));
+  // (Callers compute t as step * dt or by summation: allow for rounding.)
+  const bool moved = std::abs(tprev - t) > 1e-10 * std::max(std::abs(t), std::abs(dt));
+  int restart = copy_state(u, true) || moved;
+  MPI_Allreduce(MPI_IN_PLACE, &restart, 1, MPI_INT, MPI_LOR, grid_.comm());
+  if (restart && solved_) MG_PETSC(TSRestartStep(ts_));
+  solved_ = true;
+  const double tend = t + dt;
+  const double h0 = adaptive_ ? std::min(next_dt_, dt) : dt;
+  MG_PETSC(TSSetTime(ts_, t));
+  MG_PETSC(TSSetMaxTime(ts_, tend));
+  MG_PETSC(TSSetTimeStep(ts_, h0));
+  callback_error_ = nullptr;
+  PetscErrorCode ierr = 0;
+  {
+    QuietPetscErrors quiet;
+    ierr = TSSolve(ts_, X_);
+  }
+  auto where = [&] {
+    std::ostringstream m;
+    m.precision(10);
+    m << "step " << step << " (t = " << t << ", dt = " << dt << ")";
+    return m.str();
+  };
+  if (ierr) {
+    // A callback's own exception goes on; a UserError (from a source expression, say) with
+    // the step added.
+    if (callback_error_) {
+      const std::exception_ptr e = std::exchange(callback_error_, nullptr);
+      try {
+        std::rethrow_exception(e);
+      } catch (const UserError& ue) {
+        throw UserError(std::string(ue.what()) + " (in the TS solve of " + where() + ")");
+      }
+    }
+    const char* text = nullptr;
+    char* specific = nullptr;
+    PetscErrorMessage(ierr, &text, &specific);
+    std::fprintf(stderr, "morphogen: PETSc error in the TS solve at %s: %s%s%s\n", where().c_str(),
+                 text ? text : "error", specific && *specific ? ": " : "",
+                 specific ? specific : "");
+    throw PetscFailure(ierr);
+  }
+  TSConvergedReason reason;
+  MG_PETSC(TSGetConvergedReason(ts_, &reason));
+  // Both counters run over all solves (TS resets them only while its step number is 0).
+  const PetscInt before = steps_;
+  MG_PETSC(TSGetStepNumber(ts_, &steps_));
+  MG_PETSC(TSGetStepRejections(ts_, &rejected_));
+  const PetscInt n = steps_ - before;
+  PetscReal treached = t;
+  MG_PETSC(TSGetTime(ts_, &treached));
+  if (reason < 0) {
+    SNES snes;
+    KSP ksp;
+    SNESConvergedReason sreason;
+    KSPConvergedReason kreason;
+    MG_PETSC(TSGetSNES(ts_, &snes));
+    MG_PETSC(SNESGetConvergedReason(snes, &sreason));
+    MG_PETSC(SNESGetKSP(snes, &ksp));
+    MG_PETSC(KSPGetConvergedReason(ksp, &kreason));
+    PetscInt kits = 0;
+    MG_PETSC(KSPGetIterationNumber(ksp, &kits));
+    std::ostringstream m;
+    m.precision(10);
+    m << "TS integrator diverged at " << where() << ", internal time " << treached << ": TS "
+      << TSConvergedReasons[reason] << ", SNES " << SNESConvergedReasons[sreason] << ", KSP "
+      << KSPConvergedReasons[kreason] << " after " << kits
+      << " iterations; try a smaller -dt, -ts_adapt_type basic, or other -ksp_type / -pc_type";
+    throw UserError(m.str());
+  }
+  if (!(std::abs(treached - tend) <= 1e-12 * std::max(std::abs(tend), std::abs(dt)))) {
+    std::ostringstream m;
+    m.precision(17);
+    m << "TS integrator stopped at t = " << treached << " short of " << tend << " in " << where()
+      << " after " << n << " internal steps (TS " << TSConvergedReasons[reason]
+      << "); raise -ts_max_steps or loosen -ts_rtol/-ts_atol";
+    throw UserError(m.str());
+  }
+  if (adaptive_) {
+    PetscReal h = dt;
+    MG_PETSC(TSGetTimeStep(ts_, &h));
+    if (h > 0 && std::isfinite(h)) next_dt_ = h;
+  }
+  copy_state(u, false);
+  apply_floor(u);
+}
+
+} // namespace morphogen
