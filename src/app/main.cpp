@@ -15,6 +15,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
+#include <vector>
 
 using namespace morphogen;
 
@@ -56,21 +58,11 @@ void prepare_output(MPI_Comm comm, const Options& opt, const Simulation& sim) {
   throw_if_any(comm, err);
 }
 
-int run(int* argc, char*** argv) {
-  MPI_Comm comm = PETSC_COMM_WORLD;
-  const std::string base_dir = load_deck(argc, argv);
-  Options opt(comm);
-  if (opt.help_requested())
-    PetscPrintf(comm, "morphogen %s options (-name <current value>: help):\n", MORPHOGEN_VERSION);
-  Simulation sim(comm, opt, base_dir);
-  if (opt.help_requested()) {
-    print_models(comm);
-    return 0;
-  }
-  opt.check_unused();
+void print_header(MPI_Comm comm, const Simulation& sim, int level, int levels) {
   int size = 1;
   MPI_Comm_size(comm, &size);
   const auto& g = sim.grid().spec();
+  if (levels > 1) PetscPrintf(comm, "level %d/%d: ", level + 1, levels);
   PetscPrintf(comm, "morphogen %s: model %s, grid %lld", MORPHOGEN_VERSION, sim.model().name,
               static_cast<long long>(g.n[0]));
   for (int d = 1; d < g.dim; ++d)
@@ -82,10 +74,48 @@ int run(int* argc, char*** argv) {
               sim.stencil().name.c_str(), format_double(sim.dt()).c_str(),
               format_double(sim.stable_dt()).c_str(), static_cast<long long>(sim.steps()), size,
               size == 1 ? "" : "s", sim.output().dir.c_str());
-  prepare_output(comm, opt, sim);
-  run_loop(sim);
+}
+
+int run(int* argc, char*** argv) {
+  MPI_Comm comm = PETSC_COMM_WORLD;
+  const std::string base_dir = load_deck(argc, argv);
+  Options opt(comm);
+  if (opt.help_requested())
+    PetscPrintf(comm, "morphogen %s options (-name <current value>: help):\n", MORPHOGEN_VERSION);
+  // Coarse-to-fine grid sequencing (Witkin-Kass 5.2, Lawlor): levels 1..L-1 run on grids
+  // coarsened by 2^(L-1-l) for -sequence_steps steps each, the last on -grid_n for -steps.
+  const int levels = static_cast<int>(
+      opt.integer("sequence_levels", 1, 1, 8,
+                  "coarse-to-fine grid sequencing: number of levels, each twice as fine as the "
+                  "previous; the last is -grid_n"));
+  std::vector<PetscInt> level_steps;
+  if (levels > 1)
+    for (const auto& v :
+         opt.list("sequence_steps", {}, static_cast<size_t>(levels - 1),
+                  static_cast<size_t>(levels - 1), "steps on each coarse level, coarsest first")) {
+      const PetscInt n = Options::parse_int("sequence_steps", v);
+      if (n < 0) throw UserError("-sequence_steps " + v + ": must be >= 0");
+      level_steps.push_back(n);
+    }
+  std::unique_ptr<Simulation> prev;
+  for (int l = 0; l < levels; ++l) {
+    auto sim =
+        std::make_unique<Simulation>(comm, opt, base_dir, SequenceLevel{l, levels, prev.get()});
+    if (l == 0) {
+      if (opt.help_requested()) {
+        print_models(comm);
+        return 0;
+      }
+      opt.check_unused();
+      prepare_output(comm, opt, *sim);
+    }
+    if (l + 1 < levels) sim->set_steps(level_steps[l]);
+    print_header(comm, *sim, l, levels);
+    run_loop(*sim);
+    prev = std::move(sim);
+  }
   PetscPrintf(comm, "done: images in %s/ (*_final.png), options in %s/options_used.yaml\n",
-              sim.output().dir.c_str(), sim.output().dir.c_str());
+              prev->output().dir.c_str(), prev->output().dir.c_str());
   return 0;
 }
 

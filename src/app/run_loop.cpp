@@ -54,7 +54,7 @@ void run_loop(Simulation& sim) {
     sim.step();
     if (n % out.nan_check_every == 0 || n == steps) sim.check_finite();
     if (out.png_every > 0 && n % out.png_every == 0 && n != steps) {
-      std::snprintf(tag, sizeof tag, "%07lld", static_cast<long long>(n));
+      std::snprintf(tag, sizeof tag, "%07lld", static_cast<long long>(sim.step_index()));
       write_pngs(sim, tag);
     }
     if (n % out.progress_every == 0 || n == steps) {
@@ -73,7 +73,7 @@ void run_loop(Simulation& sim) {
       step_last = n;
     }
   }
-  std::snprintf(tag, sizeof tag, "%07lld", static_cast<long long>(steps));
+  std::snprintf(tag, sizeof tag, "%07lld", static_cast<long long>(sim.step_index()));
   write_pngs(sim, tag);
   write_pngs(sim, "final");
 }

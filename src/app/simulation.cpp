@@ -4,6 +4,7 @@
 #include "core/log_events.hpp"
 #include "core/user_error.hpp"
 #include "fields/field_fill.hpp"
+#include "grid/prolong.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -15,24 +16,52 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 }
 
-Simulation::Simulation(MPI_Comm comm, Options& opt, const std::string& base_dir)
+Simulation::Simulation(MPI_Comm comm, Options& opt, const std::string& base_dir,
+                       const SequenceLevel& level)
     : comm_(comm), base_dir_(base_dir) {
   LogScope log_scope(log_events().setup);
-  read_grid(opt);
+  read_grid(opt, level);
   read_model(opt, base_dir);
   read_time(opt);
   read_output(opt);
+  if (level.coarser) start_from(*level.coarser);
 }
 
-void Simulation::read_grid(Options& opt) {
-  const auto n =
-      opt.list("grid_n", {"256", "256"}, 2, 3, "cells per axis: nx,ny (2-D) or nx,ny,nz (3-D)");
+void Simulation::start_from(Simulation& coarser) {
+  coarser.refresh_ghosts();
+  for (size_t s = 0; s < u_.size(); ++s) {
+    const PetscScalar* c;
+    PetscScalar* f;
+    MG_PETSC(VecGetArrayRead(coarser.u_[s], &c));
+    MG_PETSC(VecGetArray(u_[s], &f));
+    prolong_cell_centred(*coarser.grid_, c, *grid_, f);
+    MG_PETSC(VecRestoreArray(u_[s], &f));
+    MG_PETSC(VecRestoreArrayRead(coarser.u_[s], &c));
+  }
+  t_ = coarser.t_;
+  step_ = coarser.step_;
+  refresh_ghosts();
+}
+
+void Simulation::read_grid(Options& opt, const SequenceLevel& level) {
+  const auto n = opt.list("grid_n", {"256", "256"}, 2, 3,
+                          "cells per axis: nx,ny (2-D) or nx,ny,nz (3-D); with "
+                          "-sequence_levels, the finest level's");
   spec_.dim = static_cast<int>(n.size());
   for (int d = 0; d < spec_.dim; ++d) {
     spec_.n[d] = Options::parse_int("grid_n", n[d]);
     if (spec_.n[d] < 3 || spec_.n[d] > (1 << 24))
       throw UserError("-grid_n " + n[d] + ": cells per axis must be in [3, 16777216]");
   }
+  const PetscInt factor = PetscInt(1) << (level.count - 1 - level.index);
+  if (factor > 1)
+    for (int d = 0; d < spec_.dim; ++d) {
+      if (spec_.n[d] % factor != 0 || spec_.n[d] / factor < 3)
+        throw UserError("-grid_n " + n[d] + ": with -sequence_levels " +
+                        std::to_string(level.count) + " every axis must be a multiple of " +
+                        std::to_string(factor) + " with at least " + std::to_string(3 * factor) +
+                        " cells");
+    }
   std::vector<std::string> Ldef;
   for (int d = 0; d < spec_.dim; ++d)
     Ldef.push_back(std::to_string(spec_.n[d]));
@@ -46,6 +75,14 @@ void Simulation::read_grid(Options& opt) {
     spec_.L[d] = Options::parse_real("grid_L", s);
     if (!(spec_.L[d] > 0) || !std::isfinite(spec_.L[d]))
       throw UserError("-grid_L " + s + ": domain length must be > 0");
+  }
+  for (int d = 0; d < spec_.dim; ++d)
+    spec_.n[d] /= factor;
+  if (level.coarser) {
+    spec_.ranges = level.coarser->grid().ownership_ranges();
+    for (auto& r : spec_.ranges)
+      for (auto& c : r)
+        c *= 2;
   }
   const auto bc = opt.list("grid_bc", {"periodic"}, 1, 3,
                            "boundary per axis, one value for all axes or one per axis "

@@ -28,10 +28,20 @@ struct OutputSettings {
   PetscInt nan_check_every = 100;
 };
 
+class Simulation;
+
+// Coarse-to-fine grid sequencing: level `index` of `count` runs on the -grid_n grid coarsened
+// by 2^(count - 1 - index) per axis and starts from the state of `coarser` (interpolated).
+struct SequenceLevel {
+  int index = 0, count = 1;
+  Simulation* coarser = nullptr;
+};
+
 class Simulation {
 public:
   // base_dir: where relative file names in values (png("...")) are looked up first.
-  Simulation(MPI_Comm comm, Options& opt, const std::string& base_dir);
+  Simulation(MPI_Comm comm, Options& opt, const std::string& base_dir,
+             const SequenceLevel& level = {});
 
   const ModelEntry& model() const { return *model_; }
   const Grid& grid() const { return *grid_; }
@@ -42,6 +52,7 @@ public:
   double dt() const { return dt_; }
   double stable_dt() const { return stable_dt_; }
   PetscInt steps() const { return steps_; }
+  void set_steps(PetscInt n) { steps_ = n; }
   double time() const { return t_; }
   PetscInt step_index() const { return step_; }
   const Stencil& stencil() const { return stencil_; }
@@ -58,7 +69,8 @@ public:
   void check_finite() const;
 
 private:
-  void read_grid(Options& opt);
+  void read_grid(Options& opt, const SequenceLevel& level);
+  void start_from(Simulation& coarser);
   void read_model(Options& opt, const std::string& base_dir);
   void read_time(Options& opt);
   void read_output(Options& opt);

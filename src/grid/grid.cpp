@@ -30,13 +30,18 @@ Grid::Grid(MPI_Comm comm, const GridSpec& spec) : spec_(spec) {
   const DMDAStencilType st = spec.box_stencil ? DMDA_STENCIL_BOX : DMDA_STENCIL_STAR;
   // A grid too small for the rank count is a user error, not an internal one.
   const std::string err = petsc_quietly([&]() -> PetscErrorCode {
+    const bool fixed = !spec.ranges[0].empty();
+    const auto count = [&](int d) {
+      return fixed ? static_cast<PetscInt>(spec.ranges[d].size()) : PETSC_DECIDE;
+    };
+    const auto lx = [&](int d) { return fixed ? spec.ranges[d].data() : nullptr; };
     if (spec.dim == 2)
-      PetscCall(DMDACreate2d(comm, dmbc(0), dmbc(1), st, spec_.n[0], spec_.n[1], PETSC_DECIDE,
-                             PETSC_DECIDE, 1, spec.stencil_width, nullptr, nullptr, dm_.out()));
+      PetscCall(DMDACreate2d(comm, dmbc(0), dmbc(1), st, spec_.n[0], spec_.n[1], count(0), count(1),
+                             1, spec.stencil_width, lx(0), lx(1), dm_.out()));
     else
       PetscCall(DMDACreate3d(comm, dmbc(0), dmbc(1), dmbc(2), st, spec_.n[0], spec_.n[1],
-                             spec_.n[2], PETSC_DECIDE, PETSC_DECIDE, PETSC_DECIDE, 1,
-                             spec.stencil_width, nullptr, nullptr, nullptr, dm_.out()));
+                             spec_.n[2], count(0), count(1), count(2), 1, spec.stencil_width, lx(0),
+                             lx(1), lx(2), dm_.out()));
     PetscCall(DMSetUp(dm_));
     return 0;
   });
@@ -68,6 +73,18 @@ VecH Grid::create_local() const {
   MG_PETSC(DMCreateLocalVector(dm_, v.out()));
   MG_PETSC(VecSet(v, 0.0));
   return v;
+}
+
+std::array<std::vector<PetscInt>, 3> Grid::ownership_ranges() const {
+  PetscInt P[3] = {1, 1, 1};
+  MG_PETSC(DMDAGetInfo(dm_, nullptr, nullptr, nullptr, nullptr, &P[0], &P[1], &P[2], nullptr,
+                       nullptr, nullptr, nullptr, nullptr, nullptr));
+  const PetscInt* l[3] = {nullptr, nullptr, nullptr};
+  MG_PETSC(DMDAGetOwnershipRanges(dm_, &l[0], &l[1], &l[2]));
+  std::array<std::vector<PetscInt>, 3> r;
+  for (int d = 0; d < spec_.dim; ++d)
+    r[d].assign(l[d], l[d] + P[d]);
+  return r;
 }
 
 VecH Grid::create_global() const {

@@ -11,6 +11,7 @@
 
 #include <array>
 #include <string>
+#include <vector>
 
 namespace morphogen {
 
@@ -25,6 +26,9 @@ struct GridSpec {
   std::array<Boundary, 3> bc{Boundary::Periodic, Boundary::Periodic, Boundary::Periodic};
   int stencil_width = 1;
   bool box_stencil = true; // ghost corners are needed by the 9-point stencil
+  // Optional cells per process along each axis (empty: PETSc decides). Grid sequencing sets
+  // them to twice the coarser level's, so each fine cell's coarse parents are local.
+  std::array<std::vector<PetscInt>, 3> ranges{};
   double h(int d) const { return L[d] / static_cast<double>(n[d]); }
 };
 
@@ -69,6 +73,8 @@ public:
   double centre(int d, PetscInt i) const { return (static_cast<double>(i) + 0.5) * spec_.h(d); }
 
   VecH create_local() const;
+  // Cells per process along each axis (what GridSpec::ranges would reproduce).
+  std::array<std::vector<PetscInt>, 3> ownership_ranges() const;
   VecH create_global() const;
 
 private:

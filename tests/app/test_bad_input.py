@@ -42,6 +42,10 @@ CASES = [
                        "-split_newton_tol", "1e-14", "-steps", "3"],
      ["reaction solve failed at cell", "residual", "Newton iterations"]),
     ("explicit_dt_suggests_split", ["-dt", "5"], ["-dt 5", "-integrator split"]),
+    ("sequence_not_divisible", ["-sequence_levels", "3", "-sequence_steps", "10,10", "-grid_n", "250,256"],
+     ["-grid_n 250", "multiple of 4"]),
+    ("sequence_steps_missing", ["-sequence_levels", "2"], ["-sequence_steps", "expected 1"]),
+    ("sequence_levels_range", ["-sequence_levels", "9"], ["-sequence_levels", "allowed [1, 8]"]),
 ]
 
 

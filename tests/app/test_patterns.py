@@ -50,3 +50,14 @@ def test_split_with_ten_times_the_explicit_bound_forms_the_same_spots(workdir):
     assert abs(lam_sp - lam_ex) / lam_ex < 0.05
     d = describe(str(workdir / "split" / "a_final.png"))
     assert d["count"] > 25 and d["median_elongation"] < 1.6, d
+
+
+def test_grid_sequencing_forms_spots_sooner(workdir):
+    """Coarse-to-fine (64^2 -> 128^2 -> 256^2, 5,000 steps on each level, 15,000 in all) gives
+    spots at the full resolution; a single-grid run needs about 30,000 steps."""
+    proc = run(["-sequence_levels", "3", "-sequence_steps", "5000,5000", "-steps", "5000",
+                "-png_every", "0", "-output_dir", str(workdir / "seq")], cwd=workdir, ranks=2)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.count("level ") == 3
+    d = describe(str(workdir / "seq" / "a_final.png"))
+    assert d["count"] > 100 and d["median_elongation"] < 1.6, d
