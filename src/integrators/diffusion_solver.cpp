@@ -1,5 +1,7 @@
 #include "integrators/diffusion_solver.hpp"
 
+#include "integrators/ksp_defaults.hpp"
+
 #include "core/collective_error.hpp"
 #include "core/log_events.hpp"
 #include "core/user_error.hpp"
@@ -66,10 +68,7 @@ void DiffusionSolver::configure(int s) {
   KSP& ksp = ksp_[s];
   MG_PETSC(KSPCreate(grid_.comm(), &ksp));
   MG_PETSC(KSPSetOptionsPrefix(ksp, "diffusion_"));
-  MG_PETSC(KSPSetType(ksp, KSPCG));
-  PC pc;
-  MG_PETSC(KSPGetPC(ksp, &pc));
-  MG_PETSC(PCSetType(pc, size == 1 ? PCICC : PCBJACOBI));
+  set_cg_icc(ksp);
   MG_PETSC(KSPSetTolerances(ksp, 1e-10, 1e-14, PETSC_DEFAULT, 10000));
   // The DMDA lets -diffusion_pc_type mg build its grid hierarchy; the operator is ours.
   MG_PETSC(KSPSetDM(ksp, grid_.dm()));
@@ -98,24 +97,7 @@ void DiffusionSolver::solve(int s, Vec u, double dt, double theta, PetscInt step
     MG_PETSC(MatScale(A_[s], -theta * c));
     MG_PETSC(MatShift(A_[s], 1.0));
     MG_PETSC(KSPSetOperators(ksp_[s], A_[s], A_[s]));
-    if (assembled_dt_[s] < 0) {
-      PC pc;
-      MG_PETSC(KSPGetPC(ksp_[s], &pc));
-      PetscBool bj = PETSC_FALSE, user_sub = PETSC_FALSE;
-      MG_PETSC(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(pc), PCBJACOBI, &bj));
-      MG_PETSC(PetscOptionsHasName(nullptr, nullptr, "-diffusion_sub_pc_type", &user_sub));
-      MG_PETSC(KSPSetUp(ksp_[s]));
-      if (bj && !user_sub) {
-        PetscInt nlocal = 0, first = 0;
-        KSP* sub = nullptr;
-        MG_PETSC(PCBJacobiGetSubKSP(pc, &nlocal, &first, &sub));
-        for (PetscInt q = 0; q < nlocal; ++q) {
-          PC spc;
-          MG_PETSC(KSPGetPC(sub[q], &spc));
-          MG_PETSC(PCSetType(spc, PCICC));
-        }
-      }
-    }
+    if (assembled_dt_[s] < 0) icc_subblocks(ksp_[s], "-diffusion_sub_pc_type");
     assembled_dt_[s] = dt;
     assembled_theta_[s] = theta;
   }

@@ -3,6 +3,7 @@
 #include "core/collective_error.hpp"
 #include "core/log_events.hpp"
 #include "core/options.hpp"
+#include "fields/clamp_floor.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -117,22 +118,6 @@ void SplitIntegrator::diffuse(std::vector<VecH>& u, double dt, PetscInt step) {
   }
 }
 
-void SplitIntegrator::apply_floor(std::vector<VecH>& u) {
-  const Box& ob = grid_.owned();
-  for (size_t s = 0; s < u.size(); ++s) {
-    if (!std::isfinite(floor_[s])) continue;
-    PetscScalar* a;
-    MG_PETSC(VecGetArray(u[s], &a));
-    for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
-      for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j) {
-        double* r = a + grid_.local_index(ob.s[0], j, k);
-        for (PetscInt i = 0; i < ob.m[0]; ++i)
-          r[i] = std::max(r[i], floor_[s]);
-      }
-    MG_PETSC(VecRestoreArray(u[s], &a));
-  }
-}
-
 void SplitIntegrator::step(std::vector<VecH>& u, double t, double dt, PetscInt step) {
   if (set_.ordering == SplitOrdering::Lie) {
     react(u, t, dt, step);
@@ -142,7 +127,7 @@ void SplitIntegrator::step(std::vector<VecH>& u, double t, double dt, PetscInt s
     diffuse(u, dt, step);
     react(u, t + 0.5 * dt, 0.5 * dt, step);
   }
-  apply_floor(u);
+  apply_floor(grid_, u, floor_);
 }
 
 } // namespace morphogen

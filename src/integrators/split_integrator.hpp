@@ -51,7 +51,6 @@ public:
 private:
   void react(std::vector<VecH>& u, double t0, double dt, PetscInt step);
   void diffuse(std::vector<VecH>& u, double dt, PetscInt step);
-  void apply_floor(std::vector<VecH>& u);
 
   const Grid& grid_;
   ReactionRowFn fn_;

@@ -1,5 +1,8 @@
 #include "integrators/ts_integrator.hpp"
 
+#include "fields/clamp_floor.hpp"
+#include "integrators/ksp_defaults.hpp"
+
 #include "core/log_events.hpp"
 #include "core/user_error.hpp"
 
@@ -174,10 +177,7 @@ void TsIntegrator::setup_ts(double dt) {
   MG_PETSC(SNESSetType(snes, SNESKSPONLY));
   KSP ksp;
   MG_PETSC(SNESGetKSP(snes, &ksp));
-  MG_PETSC(KSPSetType(ksp, KSPCG));
-  PC pc;
-  MG_PETSC(KSPGetPC(ksp, &pc));
-  MG_PETSC(PCSetType(pc, size == 1 ? PCICC : PCBJACOBI));
+  set_cg_icc(ksp);
   MG_PETSC(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, 10000));
   MG_PETSC(TSSetFromOptions(ts_));
 
@@ -214,21 +214,7 @@ void TsIntegrator::setup_ts(double dt) {
   MG_PETSC(fill_jacobian(1.0 / dt));
   jac_shift_ = -1; // force a refresh on the first call
   MG_PETSC(KSPSetOperators(ksp, J_, J_));
-  MG_PETSC(KSPGetPC(ksp, &pc));
-  PetscBool bj = PETSC_FALSE, user_sub = PETSC_FALSE;
-  MG_PETSC(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(pc), PCBJACOBI, &bj));
-  MG_PETSC(PetscOptionsHasName(nullptr, nullptr, "-sub_pc_type", &user_sub));
-  MG_PETSC(KSPSetUp(ksp));
-  if (bj && !user_sub) {
-    PetscInt nblocks = 0, first = 0;
-    KSP* sub = nullptr;
-    MG_PETSC(PCBJacobiGetSubKSP(pc, &nblocks, &first, &sub));
-    for (PetscInt q = 0; q < nblocks; ++q) {
-      PC spc;
-      MG_PETSC(KSPGetPC(sub[q], &spc));
-      MG_PETSC(PCSetType(spc, PCICC));
-    }
-  }
+  icc_subblocks(ksp, "-sub_pc_type");
 }
 
 // ---- PETSc callbacks: no exception may leave them -------------------------------------------
@@ -362,22 +348,6 @@ bool TsIntegrator::copy_state(std::vector<VecH>& u, bool to_x) {
   return changed;
 }
 
-void TsIntegrator::apply_floor(std::vector<VecH>& u) {
-  const Box& ob = grid_.owned();
-  for (size_t s = 0; s < u.size(); ++s) {
-    if (!std::isfinite(floor_[s])) continue;
-    PetscScalar* a = nullptr;
-    MG_PETSC(VecGetArray(u[s], &a));
-    for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
-      for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j) {
-        double* r = a + grid_.local_index(ob.s[0], j, k);
-        for (PetscInt i = 0; i < ob.m[0]; ++i)
-          r[i] = std::max(r[i], floor_[s]);
-      }
-    MG_PETSC(VecRestoreArray(u[s], &a));
-  }
-}
-
 void TsIntegrator::step(std::vector<VecH>& u, double t, double dt, PetscInt step) {
   if (static_cast<PetscInt>(u.size()) != ns_)
     throw std::logic_error("TsIntegrator::step: wrong number of species vectors");
@@ -470,7 +440,7 @@ void TsIntegrator::step(std::vector<VecH>& u, double t, double dt, PetscInt step
     if (h > 0 && std::isfinite(h)) next_dt_ = h;
   }
   copy_state(u, false);
-  apply_floor(u);
+  apply_floor(grid_, u, floor_);
 }
 
 } // namespace morphogen

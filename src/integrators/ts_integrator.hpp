@@ -88,7 +88,6 @@ private:
   // Owned cells between the ghosted local state and X; into X it returns whether any value
   // differed from X's (this rank).
   bool copy_state(std::vector<VecH>& u, bool to_x);
-  void apply_floor(std::vector<VecH>& u);
 
   const Grid& grid_;
   RatesFn rates_;
