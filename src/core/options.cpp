@@ -208,6 +208,8 @@ void Options::check_unused() const {
   for (PetscInt i = 0; i < n && msg.empty(); ++i) {
     const std::string name = names[i];
     if (name == "help" || name == "h") continue;
+    // Consumed later by a PETSc object (e.g. -diffusion_ksp_converged_reason at the first solve).
+    if (std::find(known_.begin(), known_.end(), name) != known_.end()) continue;
     std::string best;
     size_t bd = std::max<size_t>(3, name.size() / 3) + 1;
     auto consider = [&](const std::string& cand) {

@@ -43,7 +43,8 @@ public:
   std::optional<std::string> get(const std::string& name, const std::string& help);
   bool is_set(const std::string& name) const;
 
-  // Record an option that another layer (PETSc objects) consumes, so "did you mean" knows it.
+  // Record an option that another layer (a PETSc object) reads later: it is not reported as
+  // unused, and "did you mean" knows it.
   void known(const std::string& name) { known_.push_back(name); }
 
   const std::vector<Record>& records() const { return records_; }

@@ -32,7 +32,7 @@ DiffusionSolver::DiffusionSolver(const Grid& grid, const Halo& halo, const Stenc
        {"diffusion_ksp_type", "diffusion_pc_type", "diffusion_ksp_rtol", "diffusion_ksp_atol",
         "diffusion_ksp_max_it", "diffusion_sub_pc_type", "diffusion_pc_mg_levels",
         "diffusion_pc_mg_galerkin", "diffusion_ksp_monitor", "diffusion_ksp_view",
-        "diffusion_ksp_converged_reason", "diffusion_pc_hypre_type"})
+        "diffusion_ksp_converged_reason", "diffusion_pc_hypre_type", "diffusion_ksp_norm_type"})
     opt.known(name);
   for (size_t s = 0; s < ns; ++s)
     configure(static_cast<int>(s));

@@ -121,3 +121,12 @@ def test_grid_too_small_for_ranks(workdir):
     lines = error_lines(proc)
     assert len(lines) == 1 and "-grid_n 3,3: cannot be split over 8 ranks" in lines[0], proc.stderr
     assert not (workdir / "o").exists()
+
+
+def test_petsc_options_read_later_are_not_unknown(workdir):
+    """Options that a PETSc object reads at its first solve (after the unused-option check)
+    are accepted, e.g. -diffusion_ksp_converged_reason."""
+    proc = run(["-grid_n", "32,32", "-integrator", "split", "-dt", "5", "-steps", "2",
+                "-diffusion_ksp_converged_reason", "-output_dir", str(workdir / "o")], cwd=workdir)
+    assert proc.returncode == 0, proc.stderr
+    assert "Linear diffusion_ solve converged" in proc.stdout
