@@ -11,6 +11,20 @@ namespace morphogen {
 std::string load_deck(int* argc, char*** argv) {
   std::string deck, base_dir;
   if (*argc > 1 && (*argv)[1][0] != '-') deck = (*argv)[1];
+  // A deck anywhere else would be taken by PETSc as an option value or ignored: refuse it.
+  for (int i = 2; i < *argc; ++i) {
+    const std::string a = (*argv)[i];
+    const auto ends = [&](const std::string& e) {
+      return a.size() > e.size() && a.compare(a.size() - e.size(), e.size(), e) == 0;
+    };
+    const std::string prev = (*argv)[i - 1];
+    const bool is_value = prev.size() > 1 && prev[0] == '-' && prev != "-options_file" &&
+                          prev != "-options_file_yaml";
+    if ((ends(".yaml") || ends(".yml")) && !is_value)
+      throw UserError("deck " + a +
+                      ": the deck must be the first argument (morphogen DECK.yaml "
+                      "[-option value ...])");
+  }
   if (!deck.empty()) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(deck, ec))

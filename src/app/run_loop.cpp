@@ -53,7 +53,7 @@ void run_loop(Simulation& sim) {
   for (PetscInt n = 1; n <= steps; ++n) {
     sim.step();
     if (n % out.nan_check_every == 0 || n == steps) sim.check_finite();
-    if (out.png_every > 0 && n % out.png_every == 0 && n != steps) {
+    if (out.png_every > 0 && sim.step_index() % out.png_every == 0 && n != steps) {
       std::snprintf(tag, sizeof tag, "%07lld", static_cast<long long>(sim.step_index()));
       write_pngs(sim, tag);
     }

@@ -14,7 +14,8 @@ namespace morphogen {
 
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
-}
+constexpr double kMaxReal = std::numeric_limits<double>::max(); // finite upper bound
+} // namespace
 
 Simulation::Simulation(MPI_Comm comm, Options& opt, const std::string& base_dir,
                        const SequenceLevel& level)
@@ -78,6 +79,7 @@ void Simulation::read_grid(Options& opt, const SequenceLevel& level) {
   }
   for (int d = 0; d < spec_.dim; ++d)
     spec_.n[d] /= factor;
+  level_factor_ = factor;
   if (level.coarser) {
     spec_.ranges = level.coarser->grid().ownership_ranges();
     for (auto& r : spec_.ranges)
@@ -178,7 +180,7 @@ void Simulation::read_model(Options& opt, const std::string& base_dir) {
   for (int s = 0; s < ns; ++s) {
     const SpeciesInfo& si = model_->species[s];
     species_.emplace_back(si.name);
-    D_[s] = opt.real(std::string("D_") + si.name, si.D, 0.0, kInf,
+    D_[s] = opt.real(std::string("D_") + si.name, si.D, 0.0, kMaxReal,
                      std::string("diffusion coefficient of ") + si.name + " (" + si.doc + ")");
     const std::string ikey = std::string("init_") + si.name;
     ValueSpec init(ikey,
@@ -256,9 +258,12 @@ void Simulation::read_time(Options& opt) {
                  "every -ts_ option)");
   split_ = kind == "split";
   ts_ = kind == "ts";
-  stable_dt_ = ExplicitIntegrator::stable_dt(stencil_, D_);
+  // With grid sequencing every level uses the finest level's dt and stability bound (the
+  // bound scales with h^2), so a bad -dt fails before the first level writes anything.
+  stable_dt_ = ExplicitIntegrator::stable_dt(stencil_, D_) /
+               static_cast<double>(level_factor_ * level_factor_);
   const double def_dt = std::isfinite(stable_dt_) ? 0.9 * stable_dt_ : 1.0;
-  dt_ = opt.real("dt", def_dt, 0.0, kInf, "time step");
+  dt_ = opt.real("dt", def_dt, 0.0, kMaxReal, "time step");
   if (!(dt_ > 0)) throw UserError("-dt " + format_double(dt_) + ": must be > 0");
   if (!split_ && !ts_) {
     const bool force = opt.flag("force_dt", false,
@@ -310,6 +315,7 @@ void Simulation::read_time(Options& opt) {
         opt.integer("split_newton_max_it", 20, 1, 1000, "Newton iteration cap per cell"));
     diffusion_ = std::make_unique<DiffusionSolver>(*grid_, *halo_, stencil_, species_, D_,
                                                    dirichlet_.empty() ? nullptr : &dirichlet_, opt);
+    diffusion_->prepare(dt_, set.theta);
     split_integrator_ = std::make_unique<SplitIntegrator>(
         *grid_, model_->reaction_row[params_.any_field() ? 1 : 0], species_, params_, floor_,
         sources_.get(), *diffusion_, set);

@@ -50,6 +50,7 @@ public:
   std::vector<VecH>& state() { return u_; }
   const OutputSettings& output() const { return out_; }
   double dt() const { return dt_; }
+  // Explicit stability bound (of the finest level when grid sequencing).
   double stable_dt() const { return stable_dt_; }
   PetscInt steps() const { return steps_; }
   void set_steps(PetscInt n) { steps_ = n; }
@@ -95,6 +96,7 @@ private:
   std::unique_ptr<LaplacianMatrix> laplacian_; // TS only; before ts_integrator_ (destroyed after)
   std::unique_ptr<TsIntegrator> ts_integrator_;
   bool split_ = false, ts_ = false;
+  PetscInt level_factor_ = 1; // coarsening factor of this sequencing level (1: finest)
   std::uint64_t seed_ = 1;
   double dt_ = 0, stable_dt_ = 0, t_ = 0;
   PetscInt steps_ = 0, step_ = 0;

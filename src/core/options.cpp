@@ -4,6 +4,7 @@
 #include "core/user_error.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -98,6 +99,10 @@ PetscInt Options::parse_int(const std::string& name, const std::string& text) {
     ++end;
   if (text.empty() || !end || *end != '\0' || errno == ERANGE)
     throw UserError("-" + name + " " + text + ": not an integer");
+  if (v > std::numeric_limits<PetscInt>::max() || v < std::numeric_limits<PetscInt>::min())
+    throw UserError("-" + name + " " + text + ": out of range, allowed [" +
+                    std::to_string(std::numeric_limits<PetscInt>::min()) + ", " +
+                    std::to_string(std::numeric_limits<PetscInt>::max()) + "]");
   return static_cast<PetscInt>(v);
 }
 
@@ -210,6 +215,23 @@ void Options::check_unused() const {
     if (name == "help" || name == "h") continue;
     // Consumed later by a PETSc object (e.g. -diffusion_ksp_converged_reason at the first solve).
     if (std::find(known_.begin(), known_.end(), name) != known_.end()) continue;
+    // PETSc's diagnostics (-*_view, -*_converged_reason, -*_monitor*) are read when a solve
+    // ends; accept them for solver prefixes that this run has (diffusion_, ts_, snes_, ksp_).
+    const auto ends_with = [&](const char* suffix) {
+      const std::string sfx = suffix;
+      return name.size() >= sfx.size() &&
+             name.compare(name.size() - sfx.size(), sfx.size(), sfx) == 0;
+    };
+    const bool diagnostic = ends_with("_view") || ends_with("_converged_reason") ||
+                            name.find("_monitor") != std::string::npos;
+    bool prefix_known = false;
+    for (const char* pre : {"diffusion_", "ts_", "snes_", "ksp_", "pc_"}) {
+      const std::string p = pre;
+      if (name.compare(0, p.size(), p) != 0) continue;
+      for (const auto& k : known_)
+        if (k.compare(0, p.size(), p) == 0) prefix_known = true;
+    }
+    if (diagnostic && prefix_known) continue;
     std::string best;
     size_t bd = std::max<size_t>(3, name.size() / 3) + 1;
     auto consider = [&](const std::string& cand) {
@@ -233,7 +255,36 @@ void Options::check_unused() const {
 
 std::string Options::to_yaml(const std::string& header) const {
   std::string out = header;
-  for (auto& r : records_) {
+  // morphogen's own options with their resolved values, then every other option that was set
+  // (PETSc solver options such as -diffusion_pc_type or -ts_adapt_type), as given.
+  std::vector<Record> all = records_;
+  char* text = nullptr;
+  MG_PETSC(PetscOptionsGetAll(nullptr, &text));
+  std::stringstream ss(text ? text : "");
+  MG_PETSC(PetscFree(text));
+  std::string tok, name, value;
+  const auto flush = [&] {
+    if (name.empty() || name == "help" || name == "options_file" || name == "options_file_yaml" ||
+        name == "options_left")
+      return;
+    for (const auto& r : all)
+      if (r.name == name) return;
+    // Only options something read (a "-x" inside an expression value is not an option).
+    PetscBool used = PETSC_FALSE;
+    MG_PETSC(PetscOptionsUsed(nullptr, ("-" + name).c_str(), &used));
+    if (used) all.push_back({name, value, ""});
+  };
+  while (ss >> tok) {
+    if (tok.size() > 1 && tok[0] == '-' && std::isalpha(static_cast<unsigned char>(tok[1]))) {
+      flush();
+      name = tok.substr(1);
+      value.clear();
+    } else {
+      value += (value.empty() ? "" : " ") + tok;
+    }
+  }
+  flush();
+  for (auto& r : all) {
     std::string v;
     for (char c : r.value) {
       if (c == '"' || c == '\\') v += '\\';

@@ -84,6 +84,23 @@ void DiffusionSolver::configure(int s) {
                     "); see -help for the KSP and PC types");
 }
 
+void DiffusionSolver::prepare_species(int s, double dt, double theta) {
+  if (D_[s] == 0.0 || (assembled_dt_[s] == dt && assembled_theta_[s] == theta)) return;
+  if (A_[s]) MG_PETSC(MatDestroy(&A_[s]));
+  MG_PETSC(MatDuplicate(lap_->L(), MAT_COPY_VALUES, &A_[s]));
+  MG_PETSC(MatScale(A_[s], -theta * dt * D_[s]));
+  MG_PETSC(MatShift(A_[s], 1.0));
+  MG_PETSC(KSPSetOperators(ksp_[s], A_[s], A_[s]));
+  if (assembled_dt_[s] < 0) icc_subblocks(ksp_[s], "-diffusion_sub_pc_type");
+  assembled_dt_[s] = dt;
+  assembled_theta_[s] = theta;
+}
+
+void DiffusionSolver::prepare(double dt, double theta) {
+  for (size_t s = 0; s < D_.size(); ++s)
+    prepare_species(static_cast<int>(s), dt, theta);
+}
+
 void DiffusionSolver::solve(int s, Vec u, double dt, double theta, PetscInt step) {
   LogScope log_scope(log_events().diffusion);
   if (D_[s] == 0.0) {
@@ -91,16 +108,7 @@ void DiffusionSolver::solve(int s, Vec u, double dt, double theta, PetscInt step
     return;
   }
   const double c = dt * D_[s];
-  if (assembled_dt_[s] != dt || assembled_theta_[s] != theta) {
-    if (A_[s]) MG_PETSC(MatDestroy(&A_[s]));
-    MG_PETSC(MatDuplicate(lap_->L(), MAT_COPY_VALUES, &A_[s]));
-    MG_PETSC(MatScale(A_[s], -theta * c));
-    MG_PETSC(MatShift(A_[s], 1.0));
-    MG_PETSC(KSPSetOperators(ksp_[s], A_[s], A_[s]));
-    if (assembled_dt_[s] < 0) icc_subblocks(ksp_[s], "-diffusion_sub_pc_type");
-    assembled_dt_[s] = dt;
-    assembled_theta_[s] = theta;
-  }
+  prepare_species(s, dt, theta);
   // rhs = u + (1 - theta) c L u + c b
   MG_PETSC(VecCopy(u, rhs_));
   if (theta != 1.0) {

@@ -37,6 +37,9 @@ public:
   DiffusionSolver(const DiffusionSolver&) = delete;
   DiffusionSolver& operator=(const DiffusionSolver&) = delete;
 
+  // Assemble A_s and set the solvers up for (dt, theta) now (so that every -diffusion_ option,
+  // sub-solver ones included, is read at setup); solve() does it on demand otherwise.
+  void prepare(double dt, double theta);
   // Solve for species s in place on the global Vec u. `step` is for messages.
   void solve(int s, Vec u, double dt, double theta, PetscInt step);
 
@@ -46,6 +49,7 @@ public:
 
 private:
   void configure(int s);
+  void prepare_species(int s, double dt, double theta);
 
   const Grid& grid_;
   const Halo& halo_;

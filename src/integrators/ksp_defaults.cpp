@@ -19,16 +19,10 @@ void icc_subblocks(KSP ksp, const char* sub_pc_option) {
   PetscBool bj = PETSC_FALSE, user_sub = PETSC_FALSE;
   MG_PETSC(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(pc), PCBJACOBI, &bj));
   MG_PETSC(PetscOptionsHasName(nullptr, nullptr, sub_pc_option, &user_sub));
+  // The default goes into the options database, so that the blocks read it together with the
+  // user's other sub-solver options (e.g. -sub_pc_factor_levels) when they are set up.
+  if (bj && !user_sub) MG_PETSC(PetscOptionsSetValue(nullptr, sub_pc_option, "icc"));
   MG_PETSC(KSPSetUp(ksp));
-  if (!bj || user_sub) return;
-  PetscInt nblocks = 0, first = 0;
-  KSP* sub = nullptr;
-  MG_PETSC(PCBJacobiGetSubKSP(pc, &nblocks, &first, &sub));
-  for (PetscInt q = 0; q < nblocks; ++q) {
-    PC spc;
-    MG_PETSC(KSPGetPC(sub[q], &spc));
-    MG_PETSC(PCSetType(spc, PCICC));
-  }
 }
 
 } // namespace morphogen

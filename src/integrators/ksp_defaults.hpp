@@ -1,7 +1,7 @@
 // morphogen's default linear solver for its SPD diffusion systems: CG with incomplete Cholesky
 // on one rank, CG with block Jacobi and ICC blocks in parallel (PETSc's ICC is sequential).
 // set_cg_icc() sets the types before KSPSetFromOptions (so options override them);
-// icc_subblocks() installs ICC in the block-Jacobi blocks after KSPSetUp, unless the user gave
+// icc_subblocks() sets the solver up with ICC in the block-Jacobi blocks, unless the user gave
 // the sub-PC option named `sub_pc_option` (e.g. "-diffusion_sub_pc_type").
 #pragma once
 

@@ -46,6 +46,11 @@ CASES = [
      ["-grid_n 250", "multiple of 4"]),
     ("sequence_steps_missing", ["-sequence_levels", "2"], ["-sequence_steps", "expected 1"]),
     ("sequence_levels_range", ["-sequence_levels", "9"], ["-sequence_levels", "allowed [1, 8]"]),
+    ("sequence_dt_checked_on_finest", ["-sequence_levels", "2", "-sequence_steps", "10", "-dt", "3"],
+     ["-dt 3", "stability bound dt <= 1"]),
+    ("deck_not_first", ["-steps", "10", "turing_spots.yaml"], ["turing_spots.yaml", "must be the first argument"]),
+    ("int_overflow", ["-steps", "4294967296"], ["-steps", "4294967296", "out of range"]),
+    ("diffusion_inf", ["-D_a", "inf"], ["-D_a", "inf", "out of range"]),
 ]
 
 
