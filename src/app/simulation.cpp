@@ -280,6 +280,12 @@ void Simulation::read_time(Options& opt) {
       opt.integer("steps", 1000, 0, std::numeric_limits<PetscInt>::max(), "number of time steps");
   sources_ = std::make_unique<SourceTerms>(*grid_, opt, species_, seed_, base_dir_);
   if (ts_) {
+    // The step loop sets TS's time, final time and step from -dt: refuse the TS spellings.
+    for (const char* k : {"ts_dt", "ts_max_time", "ts_init_time", "ts_max_steps"})
+      if (opt.is_set(k))
+        throw UserError(std::string("-") + k +
+                        ": set by morphogen with -integrator ts; use -dt (the step, or the "
+                        "output interval with -ts_adapt_type basic) and -steps");
     for (const char* k :
          {"ts_type", "ts_arkimex_type", "ts_adapt_type", "ts_rtol", "ts_atol", "ts_monitor",
           "snes_type", "ksp_type", "pc_type", "sub_pc_type", "ksp_rtol"})

@@ -51,6 +51,7 @@ CASES = [
     ("deck_not_first", ["-steps", "10", "turing_spots.yaml"], ["turing_spots.yaml", "must be the first argument"]),
     ("int_overflow", ["-steps", "4294967296"], ["-steps", "4294967296", "out of range"]),
     ("diffusion_inf", ["-D_a", "inf"], ["-D_a", "inf", "out of range"]),
+    ("ts_dt_refused", ["-integrator", "ts", "-ts_dt", "0.1"], ["-ts_dt", "use -dt"]),
 ]
 
 
