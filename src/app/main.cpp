@@ -4,18 +4,23 @@
 //
 // Loads the deck (or the embedded default, Sanderson Fig. 1) into PETSc's options database,
 // overrides it with the command line, validates every option (unknown options fail with a
-// "did you mean"), writes options_used.yaml and runs. Exit codes: 0 success, 1 bad input or a
-// diverged run (one-line message), 2 an internal PETSc error (PETSc prints its trace).
+// "did you mean"), writes options_used.yaml and runs, writing snapshots and checkpoints.
+// Exit codes: 0 success, 1 bad input or a diverged run (one-line message), 2 an internal PETSc
+// error (PETSc prints its trace), 3 stopped by SIGUSR1/SIGTERM or -max_walltime after writing a
+// checkpoint (resubmit with -restart latest), 4 an output file could not be written.
 #include "app/deck.hpp"
+#include "app/restart.hpp"
 #include "app/run_loop.hpp"
 #include "app/simulation.hpp"
 #include "core/collective_error.hpp"
+#include "core/stop_signal.hpp"
 #include "core/user_error.hpp"
 
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <vector>
 
 using namespace morphogen;
@@ -97,25 +102,62 @@ int run(int* argc, char*** argv) {
       if (n < 0) throw UserError("-sequence_steps " + v + ": must be >= 0");
       level_steps.push_back(n);
     }
+  const std::string restart =
+      opt.string("restart", "",
+                 "restart from a checkpoint file, or 'latest': the newest complete checkpoint in "
+                 "-output_dir (none there: start from the initial condition)");
+  auto first = std::make_unique<Simulation>(comm, opt, base_dir, SequenceLevel{0, levels, nullptr});
+  if (opt.help_requested()) {
+    print_models(comm);
+    return 0;
+  }
+  opt.check_unused();
+  std::optional<RestartPoint> rp;
+  if (!restart.empty()) rp = locate_restart(comm, restart, first->output().dir, first->model());
+  const int start = rp ? rp->level : 0;
+  if (start >= levels)
+    throw UserError("-restart " + rp->path + ": written on grid-sequencing level " +
+                    std::to_string(start + 1) + ", but -sequence_levels is " +
+                    std::to_string(levels));
+  prepare_output(comm, opt, *first);
+  RunOutput output(comm, opt);
   std::unique_ptr<Simulation> prev;
+  PetscInt end = 0; // global step index at which the current level ends
   for (int l = 0; l < levels; ++l) {
-    auto sim =
-        std::make_unique<Simulation>(comm, opt, base_dir, SequenceLevel{l, levels, prev.get()});
-    if (l == 0) {
-      if (opt.help_requested()) {
-        print_models(comm);
-        return 0;
-      }
-      opt.check_unused();
-      prepare_output(comm, opt, *sim);
+    if (l < start) {
+      end += level_steps[l];
+      continue;
     }
+    std::unique_ptr<Simulation> sim =
+        l == 0
+            ? std::move(first)
+            : std::make_unique<Simulation>(
+                  comm, opt, base_dir, SequenceLevel{l, levels, l == start ? nullptr : prev.get()});
     if (l + 1 < levels) sim->set_steps(level_steps[l]);
+    end += sim->steps();
+    const bool restarting = rp && l == start;
+    if (restarting) {
+      if (rp->step > end)
+        throw UserError("-restart " + rp->path + ": the checkpoint is at step " +
+                        std::to_string(rp->step) + ", past the end of the run (step " +
+                        std::to_string(end) + "); raise -steps");
+      restore(*sim, *rp);
+      PetscPrintf(comm, "restart from %s: step %lld, t %.6g (written on %lld rank%s)\n",
+                  rp->path.c_str(), rp->step, rp->time, *rp->info.attributes.integer("nranks"),
+                  *rp->info.attributes.integer("nranks") == 1 ? "" : "s");
+    }
+    output.begin(*sim, restarting ? rp->step : (l == 0 ? -1 : sim->step_index()));
     print_header(comm, *sim, l, levels);
-    run_loop(*sim);
+    if (run_loop(*sim, end, output, l + 1 == levels)) return kExitResubmit;
     prev = std::move(sim);
   }
-  PetscPrintf(comm, "done: images in %s/ (*_final.png), options in %s/options_used.yaml\n",
-              prev->output().dir.c_str(), prev->output().dir.c_str());
+  const std::string& dir = prev->output().dir;
+  PetscPrintf(comm,
+              "done: ParaView %s/%s.xmf, images %s/*_final.png, checkpoint %s, options "
+              "%s/options_used.yaml\n",
+              dir.c_str(), prev->output().name.c_str(), dir.c_str(),
+              output.last_checkpoint().empty() ? "(none)" : output.last_checkpoint().c_str(),
+              dir.c_str());
   return 0;
 }
 
@@ -124,6 +166,7 @@ int run(int* argc, char*** argv) {
 int main(int argc, char** argv) {
   PetscCall(PetscInitialize(&argc, &argv, nullptr,
                             "morphogen [DECK.yaml] [-option value ...]; -help lists options\n"));
+  install_stop_signal_handlers();
   int rc = 0;
   try {
     rc = run(&argc, &argv);

@@ -41,18 +41,36 @@ void write_pngs(Simulation& sim, const std::string& tag) {
   throw_if_any(g.comm(), err);
 }
 
-void run_loop(Simulation& sim) {
+bool run_loop(Simulation& sim, PetscInt end_step, RunOutput& output, bool final_level) {
   MPI_Comm comm = sim.grid().comm();
-  const PetscInt steps = sim.steps();
+  const PetscInt first = sim.step_index();
+  const PetscInt steps = end_step - first;
   const auto& out = sim.output();
   const double cells = static_cast<double>(sim.grid().global_cells());
   char tag[32];
   const double t0 = MPI_Wtime();
   double t_last = t0;
   PetscInt step_last = 0;
+  auto check_finite = [&] {
+    try {
+      sim.check_finite();
+    } catch (const UserError& e) {
+      throw UserError(std::string(e.what()) + "; last good checkpoint: " +
+                      (output.last_checkpoint().empty() ? "none written by this run"
+                                                        : output.last_checkpoint()));
+    }
+  };
   for (PetscInt n = 1; n <= steps; ++n) {
     sim.step();
-    if (n % out.nan_check_every == 0 || n == steps) sim.check_finite();
+    if (n % out.nan_check_every == 0 || n == steps) check_finite();
+    if (output.after_step(sim)) {
+      PetscPrintf(comm,
+                  "stopped by %s at step %lld (t %.6g): checkpoint %s written; continue with "
+                  "-restart latest (exit code %d)\n",
+                  output.stop_reason().c_str(), static_cast<long long>(sim.step_index()),
+                  sim.time(), output.last_checkpoint().c_str(), kExitResubmit);
+      return true;
+    }
     if (out.png_every > 0 && sim.step_index() % out.png_every == 0 && n != steps) {
       std::snprintf(tag, sizeof tag, "%07lld", static_cast<long long>(sim.step_index()));
       write_pngs(sim, tag);
@@ -63,19 +81,24 @@ void run_loop(Simulation& sim) {
           (now - t_last) > 0 ? cells * static_cast<double>(n - step_last) / (now - t_last) : 0;
       const double elapsed = now - t0;
       const double eta = elapsed / static_cast<double>(n) * static_cast<double>(steps - n);
-      MG_PETSC(PetscPrintf(comm,
-                           "step %lld/%lld  t %.6g  %5.1f%%  %.3e cell-updates/s  elapsed %.1f s  "
-                           "ETA %.1f s\n",
-                           static_cast<long long>(n), static_cast<long long>(steps), sim.time(),
-                           100.0 * static_cast<double>(n) / static_cast<double>(steps), rate,
-                           elapsed, eta));
+      MG_PETSC(PetscPrintf(
+          comm,
+          "step %lld/%lld  t %.6g  %5.1f%%  %.3e cell-updates/s  elapsed %.1f s  "
+          "ETA %.1f s\n",
+          static_cast<long long>(sim.step_index()), static_cast<long long>(end_step), sim.time(),
+          100.0 * static_cast<double>(n) / static_cast<double>(steps), rate, elapsed, eta));
       t_last = now;
       step_last = n;
     }
   }
-  std::snprintf(tag, sizeof tag, "%07lld", static_cast<long long>(sim.step_index()));
-  write_pngs(sim, tag);
-  write_pngs(sim, "final");
+  if (final_level) {
+    check_finite();
+    std::snprintf(tag, sizeof tag, "%07lld", static_cast<long long>(sim.step_index()));
+    write_pngs(sim, tag);
+    write_pngs(sim, "final");
+    output.finish(sim);
+  }
+  return false;
 }
 
 } // namespace morphogen

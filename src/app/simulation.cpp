@@ -80,6 +80,7 @@ void Simulation::read_grid(Options& opt, const SequenceLevel& level) {
   for (int d = 0; d < spec_.dim; ++d)
     spec_.n[d] /= factor;
   level_factor_ = factor;
+  level_index_ = level.index;
   if (level.coarser) {
     spec_.ranges = level.coarser->grid().ownership_ranges();
     for (auto& r : spec_.ranges)
@@ -365,7 +366,43 @@ void Simulation::read_output(Options& opt) {
                   std::numeric_limits<PetscInt>::max(), "print a progress line every N steps");
   out_.nan_check_every =
       opt.integer("nan_check_every", 100, 1, std::numeric_limits<PetscInt>::max(),
-                  "check for NaN/Inf every N steps (stops the run with the cell and time)");
+                  "check for NaN/Inf every N steps (stops the run with the cell, time and the last "
+                  "good checkpoint)");
+  read_snapshot_options(opt);
+}
+
+void Simulation::read_snapshot_options(Options& opt) {
+  const PetscInt imax = std::numeric_limits<PetscInt>::max();
+  out_.name = opt.string("output_name", "morphogen",
+                         "run name: snapshots <name>_<step>.vtkhdf, indexes <name>.vtkhdf.series "
+                         "and <name>.xmf (open the .xmf in ParaView)");
+  if (out_.name.empty() ||
+      out_.name.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnop"
+                                  "qrstuvwxyz0123456789_-.") != std::string::npos)
+    throw UserError("-output_name " + out_.name +
+                    ": allowed characters are letters, digits, '_', '-' and '.'");
+  out_.snapshot_every = opt.integer("snapshot_every", 0, 0, imax,
+                                    "write a VTKHDF snapshot every N steps and at step 0 (0: "
+                                    "only the final state)");
+  out_.snapshot_every_time = opt.real("snapshot_every_time", 0, 0, kMaxReal,
+                                      "write a snapshot every T of simulated time (0: off)");
+  out_.snapshot_single =
+      opt.choice("snapshot_precision", "float32", {"float32", "float64"},
+                 "value type of snapshot files (checkpoints are float64)") == "float32";
+  out_.checkpoint_every =
+      opt.integer("checkpoint_every", 0, 0, imax, "write a checkpoint every N steps (0: off)");
+  out_.checkpoint_every_time = opt.real("checkpoint_every_time", 0, 0, kMaxReal,
+                                        "write a checkpoint every T of simulated time (0: off)");
+  out_.checkpoint_every_walltime =
+      opt.real("checkpoint_every_walltime", 0, 0, kMaxReal,
+               "write a checkpoint every W minutes of wall time (0: off)");
+  out_.max_walltime = opt.real("max_walltime", 0, 0, kMaxReal,
+                               "wall-time budget in minutes: before it runs out, write a "
+                               "checkpoint and exit with code 3 (0: none)");
+  out_.checkpoint_keep =
+      opt.integer("checkpoint_keep", 2, 1, 1000000, "number of most recent checkpoints kept");
+  out_.checkpoint_final =
+      opt.flag("checkpoint_final", true, "write a checkpoint of the final state (to extend a run)");
 }
 
 void Simulation::step() {

@@ -26,6 +26,18 @@ struct OutputSettings {
   std::vector<std::array<double, 2>> png_range; // lo > hi means automatic (min/max per image)
   PetscInt progress_every = 0;
   PetscInt nan_check_every = 100;
+  // VTKHDF snapshots <name>_<step>.vtkhdf with <name>.vtkhdf.series and <name>.xmf indexes.
+  std::string name = "morphogen";
+  PetscInt snapshot_every = 0; // 0: only the final state
+  double snapshot_every_time = 0;
+  bool snapshot_single = true; // float32
+  // Checkpoints checkpoint_<step>.vtkhdf (float64 + /morphogen restart attributes).
+  PetscInt checkpoint_every = 0;
+  double checkpoint_every_time = 0;
+  double checkpoint_every_walltime = 0; // minutes
+  double max_walltime = 0;              // minutes: checkpoint and exit 3 before this
+  PetscInt checkpoint_keep = 2;
+  bool checkpoint_final = true;
 };
 
 class Simulation;
@@ -58,6 +70,12 @@ public:
   PetscInt step_index() const { return step_; }
   const Stencil& stencil() const { return stencil_; }
   std::uint64_t seed() const { return seed_; }
+  int level() const { return level_index_; }
+  // Set the clock after loading a checkpoint into state() (then call refresh_ghosts()).
+  void set_clock(double t, PetscInt step) {
+    t_ = t;
+    step_ = step;
+  }
 
   // Advance one step with the configured integrator.
   void step();
@@ -75,6 +93,7 @@ private:
   void read_model(Options& opt, const std::string& base_dir);
   void read_time(Options& opt);
   void read_output(Options& opt);
+  void read_snapshot_options(Options& opt);
   void add_sources(double t);
 
   MPI_Comm comm_;
@@ -97,6 +116,7 @@ private:
   std::unique_ptr<TsIntegrator> ts_integrator_;
   bool split_ = false, ts_ = false;
   PetscInt level_factor_ = 1; // coarsening factor of this sequencing level (1: finest)
+  int level_index_ = 0;
   std::uint64_t seed_ = 1;
   double dt_ = 0, stable_dt_ = 0, t_ = 0;
   PetscInt steps_ = 0, step_ = 0;

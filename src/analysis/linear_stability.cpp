@@ -1,0 +1,520 @@
+// Linear stability analysis: see linear_stability.hpp for the equations and the contract.
+#include "analysis/linear_stability.hpp"
+
+#include "core/user_error.hpp"
+#include "operators/stencil.hpp"
+
+#include <petscblaslapack.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numbers>
+
+namespace morphogen::analysis {
+
+namespace {
+
+constexpr int kMaxSpecies = 4;
+constexpr double kPi = std::numbers::pi;
+
+std::string fmt(const char* f, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
+}
+
+double inf_norm(int n, const double* A) {
+  double best = 0;
+  for (int s = 0; s < n; ++s) {
+    double row = 0;
+    for (int r = 0; r < n; ++r)
+      row += std::abs(A[s * n + r]);
+    best = std::max(best, row);
+  }
+  return best;
+}
+
+double rate_of(std::complex<double> l, double dt) {
+  return dt > 0 ? std::log(std::abs(1.0 + dt * l)) / dt : l.real();
+}
+
+// sigma(q) and the frequency of the eigenvalue attaining it, for A = J - q diag(D).
+struct Dispersion {
+  int n = 0;
+  const double* J = nullptr;
+  const double* D = nullptr;
+  double dt = 0;
+  bool general = false;
+
+  DispersionPoint at(double q) const {
+    double A[kMaxSpecies * kMaxSpecies];
+    for (int i = 0; i < n * n; ++i)
+      A[i] = J[i];
+    for (int s = 0; s < n; ++s)
+      A[s * n + s] -= q * D[s];
+    std::complex<double> ev[kMaxSpecies];
+    DispersionPoint p{0, std::numeric_limits<double>::quiet_NaN(), 0};
+    if (!eigenvalues(n, A, ev, general)) return p;
+    p.growth = -std::numeric_limits<double>::infinity();
+    for (int i = 0; i < n; ++i) {
+      const double g = rate_of(ev[i], dt);
+      if (g > p.growth || (g == p.growth && std::abs(ev[i].imag()) > p.frequency)) {
+        p.growth = g;
+        p.frequency = std::abs(ev[i].imag());
+      }
+    }
+    return p;
+  }
+};
+
+Stencil stencil_of(const DiscreteGrid& g) {
+  Stencil st;
+  if (g.dim < 2 || g.dim > 3 || !make_stencil(g.stencil, g.dim, g.h.data(), st))
+    throw UserError("linear stability: stencil '" + g.stencil + "' is not available in " +
+                    std::to_string(g.dim) + "-D with these spacings");
+  return st;
+}
+
+// -symbol; the stencils are symmetric in every axis, so sum_t w_t cos(k . off_t h).
+double q_of(const Stencil& st, const DiscreteGrid& g, const std::array<double, 3>& k) {
+  double s = 0;
+  for (int t = 0; t < st.nterms; ++t) {
+    double phase = 0;
+    for (int d = 0; d < g.dim; ++d)
+      phase += k[d] * st.off[t][d] * g.h[d];
+    s += st.w[t] * std::cos(phase);
+  }
+  return -s;
+}
+
+// Golden-section search for the maximum of f on [a, b].
+template <class F> double golden_max(F&& f, double a, double b, double tol) {
+  const double r = (std::sqrt(5.0) - 1) / 2;
+  double c = b - r * (b - a), d = a + r * (b - a);
+  double fc = f(c), fd = f(d);
+  while (b - a > tol) {
+    if (fc >= fd) {
+      b = d, d = c, fd = fc;
+      c = b - r * (b - a), fc = f(c);
+    } else {
+      a = c, c = d, fc = fd;
+      d = a + r * (b - a), fd = f(d);
+    }
+  }
+  return fc >= fd ? c : d;
+}
+
+// A point where f crosses tol between lo (f <= tol) and hi (f > tol).
+template <class F> double bisect_edge(F&& f, double lo, double hi, double tol_f, double tol_k) {
+  while (std::abs(hi - lo) > tol_k) {
+    const double mid = 0.5 * (lo + hi);
+    (f(mid) > tol_f ? hi : lo) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+// Solve the n x n system M x = b in place (partial pivoting); false if singular.
+bool solve_small(int n, double* M, double* b) {
+  for (int c = 0; c < n; ++c) {
+    int p = c;
+    for (int r = c + 1; r < n; ++r)
+      if (std::abs(M[r * n + c]) > std::abs(M[p * n + c])) p = r;
+    if (!(std::abs(M[p * n + c]) > 0)) return false;
+    if (p != c) {
+      for (int j = 0; j < n; ++j)
+        std::swap(M[c * n + j], M[p * n + j]);
+      std::swap(b[c], b[p]);
+    }
+    for (int r = c + 1; r < n; ++r) {
+      const double f = M[r * n + c] / M[c * n + c];
+      for (int j = c; j < n; ++j)
+        M[r * n + j] -= f * M[c * n + j];
+      b[r] -= f * b[c];
+    }
+  }
+  for (int c = n - 1; c >= 0; --c) {
+    for (int j = c + 1; j < n; ++j)
+      b[c] -= M[c * n + j] * b[j];
+    b[c] /= M[c * n + c];
+  }
+  return true;
+}
+
+double max_abs(const std::vector<double>& v) {
+  double m = 0;
+  for (double x : v)
+    m = std::max(m, std::abs(x));
+  return m;
+}
+
+} // namespace
+
+bool eigenvalues(int n, const double* A, std::complex<double>* out, bool general) {
+  if (n < 1 || n > kMaxSpecies) return false;
+  if (n == 1) {
+    out[0] = A[0];
+    return true;
+  }
+  if (n == 2 && !general) {
+    const double half = 0.5 * (A[0] + A[3]), dh = 0.5 * (A[0] - A[3]);
+    const double disc = dh * dh + A[1] * A[2];
+    const double r = std::sqrt(std::abs(disc));
+    if (disc >= 0) {
+      out[0] = half + r, out[1] = half - r;
+    } else {
+      out[0] = {half, r}, out[1] = {half, -r};
+    }
+    return true;
+  }
+  // LAPACK is column-major: it sees A^T, which has the same eigenvalues.
+  double a[kMaxSpecies * kMaxSpecies], wr[kMaxSpecies], wi[kMaxSpecies], vdum[1],
+      work[16 * kMaxSpecies];
+  std::copy(A, A + n * n, a);
+  PetscBLASInt nb = n, lda = n, one = 1, lwork = 16 * kMaxSpecies, info = 0;
+  LAPACKgeev_("N", "N", &nb, a, &lda, wr, wi, vdum, &one, vdum, &one, work, &lwork, &info);
+  if (info != 0) return false;
+  for (int i = 0; i < n; ++i)
+    out[i] = {wr[i], wi[i]};
+  return true;
+}
+
+double laplacian_q(const DiscreteGrid* grid, const std::array<double, 3>& k) {
+  if (!grid) return k[0] * k[0] + k[1] * k[1] + k[2] * k[2];
+  return q_of(stencil_of(*grid), *grid, k);
+}
+
+DispersionPoint growth_at_q(const StabilityResult& r, double q) {
+  if (!r.has_steady_state)
+    throw UserError("linear stability: no steady state was analysed (growth_at_q)");
+  const Dispersion disp{r.nspecies, r.jacobian.data(), r.diffusion.data(), r.dt,
+                        r.general_eigensolver};
+  DispersionPoint p = disp.at(q);
+  p.k = std::sqrt(std::max(q, 0.0));
+  return p;
+}
+
+StabilityResult analyse_jacobian(int n, const double* J, const double* D,
+                                 const StabilityOptions& opt) {
+  if (n < 1 || n > kMaxSpecies)
+    throw UserError("linear stability: " + std::to_string(n) + " species (1 to 4 supported)");
+  if (opt.samples < 3) throw UserError("linear stability: samples must be at least 3");
+  for (int s = 0; s < n; ++s)
+    if (!(D[s] >= 0) || !std::isfinite(D[s]))
+      throw UserError("linear stability: diffusion coefficients must be finite and >= 0");
+  StabilityResult r;
+  r.nspecies = n;
+  r.has_steady_state = true;
+  r.jacobian.assign(J, J + n * n);
+  r.diffusion.assign(D, D + n);
+  r.grid = opt.grid;
+  r.dt = opt.dt;
+  r.general_eigensolver = opt.general_eigensolver;
+  const double scale = inf_norm(n, J);
+  r.tol = opt.zero_tol * scale;
+
+  // k = 0: the kinetics alone.
+  r.eigen0.resize(n);
+  if (!eigenvalues(n, J, r.eigen0.data(), opt.general_eigensolver))
+    throw UserError("linear stability: the eigenvalue computation (LAPACK dgeev) failed");
+  r.growth0 = -std::numeric_limits<double>::infinity();
+  for (const auto& l : r.eigen0) {
+    const double g = rate_of(l, opt.dt);
+    r.growth0 = std::max(r.growth0, g);
+    if (std::abs(l.imag()) > r.tol && g > r.tol) r.hopf = true;
+  }
+  r.stable_homogeneous = r.growth0 < -r.tol;
+
+  // The dispersion curve sigma(k) along the direction.
+  std::array<double, 3> e = opt.direction;
+  const int dim = opt.grid ? opt.grid->dim : 3;
+  double norm = 0;
+  for (int d = 0; d < 3; ++d) {
+    if (d >= dim) e[d] = 0;
+    norm += e[d] * e[d];
+  }
+  if (!(norm > 0)) throw UserError("linear stability: the direction of k is zero");
+  for (double& c : e)
+    c /= std::sqrt(norm);
+  Stencil st;
+  if (opt.grid) st = stencil_of(*opt.grid);
+  const Dispersion disp{n, r.jacobian.data(), r.diffusion.data(), opt.dt,
+                        opt.general_eigensolver};
+  auto point = [&](double k) {
+    const std::array<double, 3> kv{k * e[0], k * e[1], k * e[2]};
+    DispersionPoint p = disp.at(opt.grid ? q_of(st, *opt.grid, kv) : k * k);
+    p.k = k;
+    return p;
+  };
+  auto growth = [&](double k) { return point(k).growth; };
+
+  r.k_max = opt.k_max;
+  if (!(r.k_max > 0)) {
+    if (opt.grid) {
+      r.k_max = std::numeric_limits<double>::infinity();
+      for (int d = 0; d < dim; ++d)
+        if (std::abs(e[d]) > 1e-12) r.k_max = std::min(r.k_max, kPi / (opt.grid->h[d] * std::abs(e[d])));
+    } else {
+      double dmin = std::numeric_limits<double>::infinity();
+      for (int s = 0; s < n; ++s)
+        if (D[s] > 0) dmin = std::min(dmin, D[s]);
+      // All D = 0: sigma does not depend on k; any range will do.
+      r.k_max = std::isfinite(dmin) ? 3.0 * std::sqrt((scale > 0 ? scale : 1.0) / dmin) : 1.0;
+    }
+  }
+  const int ns = opt.samples;
+  r.curve.resize(ns);
+  int imax = 0;
+  for (int i = 0; i < ns; ++i) {
+    r.curve[i] = point(r.k_max * i / (ns - 1));
+    if (r.curve[i].growth > r.curve[imax].growth) imax = i;
+  }
+
+  // Refine the maximum inside the bracket of the best sample; keep an end if it is higher.
+  const double ktol = opt.k_tol * r.k_max;
+  const double a = r.curve[std::max(imax - 1, 0)].k, b = r.curve[std::min(imax + 1, ns - 1)].k;
+  double kbest = golden_max(growth, a, b, ktol);
+  for (double kc : {a, b, r.curve[imax].k})
+    if (growth(kc) > growth(kbest)) kbest = kc;
+  const DispersionPoint best = point(kbest);
+  r.k_fastest = best.k;
+  r.growth_fastest = best.growth;
+  r.frequency_fastest = best.frequency;
+  r.wavelength_fastest =
+      best.k > 0 ? 2 * kPi / best.k : std::numeric_limits<double>::infinity();
+  r.oscillatory_fastest = best.k > 0 && best.frequency > r.tol;
+  r.marginal = std::abs(best.growth) <= r.tol;
+  r.turing_unstable = r.stable_homogeneous && best.growth > r.tol && best.k > 0;
+
+  // The unstable band around k_fastest: walk the samples outwards, bisect the crossings.
+  if (best.growth > r.tol) {
+    r.has_band = true;
+    int j = imax;
+    while (j >= 0 && r.curve[j].k >= kbest)
+      --j;
+    while (j >= 0 && r.curve[j].growth > r.tol)
+      --j;
+    if (j < 0) {
+      r.k_lo = 0;
+    } else {
+      const double hi = j + 1 < ns && r.curve[j + 1].k < kbest ? r.curve[j + 1].k : kbest;
+      r.k_lo = bisect_edge(growth, r.curve[j].k, hi, r.tol, ktol);
+    }
+    j = imax;
+    while (j < ns && r.curve[j].k <= kbest)
+      ++j;
+    while (j < ns && r.curve[j].growth > r.tol)
+      ++j;
+    if (j >= ns) {
+      r.k_hi = r.k_max;
+      r.band_open = true;
+    } else {
+      const double lo = j - 1 >= 0 && r.curve[j - 1].k > kbest ? r.curve[j - 1].k : kbest;
+      r.k_hi = bisect_edge(growth, r.curve[j].k, lo, r.tol, ktol);
+    }
+  }
+  return r;
+}
+
+StabilityResult analyse(const ModelEntry& entry, const std::vector<double>& params,
+                        const std::vector<double>& D, const StabilityOptions& opt) {
+  const int n = entry.nspecies;
+  if (static_cast<int>(params.size()) != entry.nparams || static_cast<int>(D.size()) != n)
+    throw UserError(std::string("linear stability of ") + entry.name + ": expected " +
+                    std::to_string(entry.nparams) + " parameters and " + std::to_string(n) +
+                    " diffusion coefficients");
+  std::vector<double> u(n);
+  if (!opt.u_star.empty()) {
+    if (static_cast<int>(opt.u_star.size()) != n)
+      throw UserError(std::string("linear stability of ") + entry.name + ": u_star needs " +
+                      std::to_string(n) + " values");
+    u = opt.u_star;
+  } else if (!entry.steady_state(params.data(), u.data())) {
+    StabilityResult r;
+    r.nspecies = n;
+    r.diffusion = D;
+    r.grid = opt.grid;
+    r.dt = opt.dt;
+    return r;
+  }
+  std::vector<double> J(n * n);
+  entry.jacobian(u.data(), params.data(), J.data());
+  StabilityResult r = analyse_jacobian(n, J.data(), D.data(), opt);
+  r.u_star = u;
+  return r;
+}
+
+std::vector<double> default_params(const ModelEntry& entry) {
+  std::vector<double> p(entry.nparams);
+  for (int i = 0; i < entry.nparams; ++i)
+    p[i] = entry.params[i].def;
+  return p;
+}
+
+std::vector<double> default_diffusion(const ModelEntry& entry) {
+  std::vector<double> D(entry.nspecies);
+  for (int s = 0; s < entry.nspecies; ++s)
+    D[s] = entry.species[s].D;
+  return D;
+}
+
+std::vector<double> allowed_wavenumbers(const DiscreteGrid& grid, int axis) {
+  if (axis < 0 || axis >= grid.dim || grid.n[axis] < 1 || !(grid.h[axis] > 0))
+    throw UserError("linear stability: axis " + std::to_string(axis) +
+                    " of the grid needs n >= 1 and h > 0");
+  const double L = static_cast<double>(grid.n[axis]) * grid.h[axis];
+  const long long mmax = grid.periodic[axis] ? grid.n[axis] / 2 : grid.n[axis] - 1;
+  std::vector<double> k(mmax + 1);
+  for (long long m = 0; m <= mmax; ++m)
+    k[m] = (grid.periodic[axis] ? 2 * kPi : kPi) * static_cast<double>(m) / L;
+  return k;
+}
+
+AllowedMode fastest_allowed_mode(const StabilityResult& r, const DiscreteGrid& grid) {
+  if (!r.has_steady_state)
+    throw UserError("linear stability: no steady state, so no fastest allowed mode");
+  const Stencil st = stencil_of(grid);
+  std::array<std::vector<double>, 3> k, c; // wavenumbers and cos(k h) per axis
+  for (int d = 0; d < 3; ++d) {
+    k[d] = d < grid.dim ? allowed_wavenumbers(grid, d) : std::vector<double>{0.0};
+    for (double kd : k[d])
+      c[d].push_back(std::cos(kd * (d < grid.dim ? grid.h[d] : 0.0)));
+  }
+  const Dispersion disp{r.nspecies, r.jacobian.data(), r.diffusion.data(), r.dt,
+                        r.general_eigensolver};
+  AllowedMode best;
+  best.growth = -std::numeric_limits<double>::infinity();
+  const long long n0 = k[0].size(), n1 = k[1].size(), n2 = k[2].size();
+  for (long long i2 = 0; i2 < n2; ++i2)
+    for (long long i1 = 0; i1 < n1; ++i1)
+      for (long long i0 = 0; i0 < n0; ++i0) {
+        if (i0 == 0 && i1 == 0 && i2 == 0) continue;
+        // Symmetric stencils: cos(k . off h) = prod_d cos(k_d off_d h_d) summed over the taps.
+        const double cd[3] = {c[0][i0], c[1][i1], c[2][i2]};
+        double s = 0;
+        for (int t = 0; t < st.nterms; ++t) {
+          double f = st.w[t];
+          for (int d = 0; d < grid.dim; ++d)
+            if (st.off[t][d] != 0) f *= cd[d];
+          s += f;
+        }
+        const DispersionPoint p = disp.at(-s);
+        ++best.scanned;
+        if (p.growth > best.growth) {
+          best.m = {i0, i1, i2};
+          best.k = {k[0][i0], k[1][i1], k[2][i2]};
+          best.q = -s;
+          best.growth = p.growth;
+          best.frequency = p.frequency;
+        }
+      }
+  best.k_abs = std::sqrt(best.k[0] * best.k[0] + best.k[1] * best.k[1] + best.k[2] * best.k[2]);
+  best.wavelength = best.k_abs > 0 ? 2 * kPi / best.k_abs : 0;
+  return best;
+}
+
+std::vector<std::vector<double>> find_steady_states(const ModelEntry& entry,
+                                                    const std::vector<double>& params,
+                                                    const SteadySearch& search) {
+  const int n = entry.nspecies;
+  if (static_cast<int>(params.size()) != entry.nparams || n > kMaxSpecies)
+    throw UserError(std::string("steady states of ") + entry.name + ": expected " +
+                    std::to_string(entry.nparams) + " parameters");
+  std::vector<double> own(n);
+  const bool has_own = entry.steady_state(params.data(), own.data());
+  std::vector<double> lo(n), hi(n);
+  for (int s = 0; s < n; ++s) {
+    const double h = 2 * std::max({1.0, std::abs(entry.species[s].init),
+                                   has_own ? std::abs(own[s]) : 0.0});
+    lo[s] = s < static_cast<int>(search.lo.size()) ? search.lo[s] : -h;
+    hi[s] = s < static_cast<int>(search.hi.size()) ? search.hi[s] : h;
+  }
+  const int pts = std::max(search.points, 1);
+  long long starts = 1;
+  for (int s = 0; s < n; ++s)
+    starts *= pts;
+
+  std::vector<std::vector<double>> found;
+  auto newton = [&](std::vector<double> u) {
+    double R[kMaxSpecies], J[kMaxSpecies * kMaxSpecies];
+    const double bound = 1e3 * (1 + std::max(max_abs(lo), max_abs(hi)));
+    for (int it = 0; it < search.max_it; ++it) {
+      entry.rates(u.data(), params.data(), R);
+      entry.jacobian(u.data(), params.data(), J);
+      if (!solve_small(n, J, R)) return;
+      double step = 0;
+      for (int s = 0; s < n; ++s) {
+        u[s] -= R[s];
+        step = std::max(step, std::abs(R[s]));
+      }
+      if (!std::isfinite(step) || max_abs(u) > bound) return;
+      if (step <= 1e-15 * (1 + max_abs(u))) break;
+    }
+    entry.rates(u.data(), params.data(), R);
+    entry.jacobian(u.data(), params.data(), J);
+    double res = 0;
+    for (int s = 0; s < n; ++s)
+      res = std::max(res, std::abs(R[s]));
+    if (!std::isfinite(res) || res > 1e-10 * (1 + inf_norm(n, J) * max_abs(u))) return;
+    for (const auto& v : found) {
+      double d = 0;
+      for (int s = 0; s < n; ++s)
+        d = std::max(d, std::abs(u[s] - v[s]));
+      if (d <= 1e-7 * (1 + max_abs(u))) return;
+    }
+    found.push_back(u);
+  };
+  if (has_own) newton(own);
+  for (long long c = 0; c < starts; ++c) {
+    std::vector<double> u(n);
+    long long idx = c;
+    for (int s = 0; s < n; ++s, idx /= pts)
+      u[s] = pts == 1 ? 0.5 * (lo[s] + hi[s]) : lo[s] + (hi[s] - lo[s]) * (idx % pts) / (pts - 1);
+    newton(u);
+  }
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
+std::string summary(const StabilityResult& r) {
+  if (!r.has_steady_state) return "no homogeneous steady state";
+  const std::string fastest = "fastest wavelength " + fmt("%.3g", r.wavelength_fastest) +
+                              " (k " + fmt("%.3g", r.k_fastest) + "), growth " +
+                              fmt("%.3g", r.growth_fastest);
+  std::string band;
+  if (r.has_band)
+    band = "; unstable band k in [" + fmt("%.3g", r.k_lo) + ", " + fmt("%.3g", r.k_hi) +
+           (r.band_open ? "] (open: still growing at k_max)" : "]");
+  if (r.hopf) {
+    double w = 0, g = -std::numeric_limits<double>::infinity();
+    for (const auto& l : r.eigen0)
+      if (rate_of(l, r.dt) > g) g = rate_of(l, r.dt), w = std::abs(l.imag());
+    std::string s = "Hopf-unstable at k = 0: growth " + fmt("%.3g", g) + ", frequency " +
+                    fmt("%.3g", w) + " (period " + fmt("%.3g", 2 * kPi / w) + ")";
+    if (r.k_fastest > 0) s += "; " + fastest;
+    return s + band;
+  }
+  if (r.growth0 > r.tol)
+    return "unstable at k = 0 (real eigenvalue, growth " + fmt("%.3g", r.growth0) + ")" + band;
+  if (r.turing_unstable)
+    return std::string(r.oscillatory_fastest ? "wave-unstable (oscillatory, frequency " +
+                                                   fmt("%.3g", r.frequency_fastest) + "): "
+                                             : "Turing-unstable: ") +
+           fastest + band;
+  if (r.marginal)
+    return "marginal (on the instability threshold): " + fastest;
+  return "stable: slowest decay " + fmt("%.3g", r.growth_fastest) + " at k " +
+         fmt("%.3g", r.k_fastest) + " (wavelength " + fmt("%.3g", r.wavelength_fastest) + ")";
+}
+
+std::string summary(const AllowedMode& m) {
+  std::string s = "fastest allowed mode m = (" + std::to_string(m.m[0]) + ", " +
+                  std::to_string(m.m[1]) + ", " + std::to_string(m.m[2]) + "): wavelength " +
+                  fmt("%.4g", m.wavelength) + " (|k| " + fmt("%.4g", m.k_abs) + "), growth " +
+                  fmt("%.3g", m.growth);
+  if (m.frequency > 0) s += ", frequency " + fmt("%.3g", m.frequency);
+  return s;
+}
+
+} // namespace morphogen::analysis

@@ -1,0 +1,153 @@
+// Linear (Turing / Hopf) stability of a homogeneous steady state u* of
+//
+//   du_s/dt = D_s lap u_s + R_s(u; p),   s = 0..N-1 (N <= 4).
+//
+// A perturbation e exp(i k.x + lambda t) grows or decays with lambda an eigenvalue of
+//
+//   A(q) = J - q diag(D),   J[s*N+r] = dR_s/du_r (u*),
+//
+// where q >= 0 is minus the symbol of the Laplacian at wave vector k:
+//   continuous:   q = |k|^2
+//   5pt, 7pt:     q = sum_d (4 / h_d^2) sin^2(k_d h_d / 2)
+//   9pt:          q = (20 - 8 (cos t_x + cos t_y) - 4 cos t_x cos t_y) / (6 h^2),  t_d = k_d h
+// (computed from the stencil weights of operators/stencil.hpp, so it is the simulated operator).
+// The growth rate of k is sigma(k) = max Re lambda(A(q(k))); with dt > 0 it is instead the rate
+// of the forward Euler map u <- (I + dt A) u, ln|1 + dt lambda| / dt (what the explicit
+// integrator does). The dispersion curve is sampled on k in [0, k_max] along a direction and its
+// maximum refined by golden-section search. Classification (tol = zero_tol * ||J||_inf):
+//   stable_homogeneous  every Re lambda(A(0)) < -tol
+//   hopf                A(0) has a complex pair (|Im| > tol) with Re > tol
+//   turing_unstable     stable_homogeneous and max_{k>0} sigma(k) > tol
+//   marginal            |max_k sigma(k)| <= tol (on a Turing or Hopf threshold)
+//   oscillatory_fastest the fastest k > 0 has |Im lambda| > tol (wave instability)
+// Eigenvalues: closed form for N = 2, LAPACK dgeev otherwise. Pure computation: no MPI, no
+// PETSc objects; bad input (sizes, unknown stencil) throws UserError.
+#pragma once
+
+#include "app/model_registry.hpp"
+
+#include <array>
+#include <complex>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace morphogen::analysis {
+
+// A structured grid as the analysis needs it: spacing and cells per axis, the Laplacian
+// stencil ("5pt"/"9pt" in 2-D, "7pt" in 3-D) and per axis periodic (modes 2 pi m / L,
+// 0 <= m <= n/2) or zero-flux (cosine modes pi m / L, 0 <= m < n). L_d = n_d h_d.
+struct DiscreteGrid {
+  int dim = 2;
+  std::array<double, 3> h{1, 1, 1};
+  std::array<long long, 3> n{0, 0, 0}; // needed only for the allowed modes
+  std::array<bool, 3> periodic{true, true, true};
+  std::string stencil = "5pt";
+};
+
+struct StabilityOptions {
+  std::optional<DiscreteGrid> grid;         // none: the continuous Laplacian, q = |k|^2
+  std::array<double, 3> direction{1, 0, 0}; // direction of k for the curve (grid symbol only)
+  double k_max = 0;      // 0: the grid's Nyquist pi/h along direction, or, continuous,
+                         //    3 sqrt(||J||_inf / min positive D) (a few times the fastest k)
+  int samples = 1024;    // sampled points of the dispersion curve on [0, k_max]
+  double k_tol = 1e-10;  // golden-section / bisection tolerance, relative to k_max
+  double dt = 0;         // > 0: rates of the forward Euler step, ln|1 + dt lambda| / dt
+  double zero_tol = 1e-9; // relative to ||J||_inf: below it a rate counts as zero
+  std::vector<double> u_star; // analyse this state instead of the model's steady_state
+  bool general_eigensolver = false; // LAPACK even for N = 2 (used by the tests)
+};
+
+struct DispersionPoint {
+  double k;         // |k|
+  double growth;    // sigma(k)
+  double frequency; // Im of the eigenvalue that attains sigma (>= 0)
+};
+
+struct StabilityResult {
+  int nspecies = 0;
+  bool has_steady_state = false;
+  std::vector<double> u_star;    // the state analysed
+  std::vector<double> jacobian;  // J at u_star, N*N row-major
+  std::vector<double> diffusion; // D
+  std::optional<DiscreteGrid> grid;
+  double dt = 0;
+  bool general_eigensolver = false;
+  double tol = 0; // zero_tol * ||J||_inf
+
+  std::vector<std::complex<double>> eigen0; // eigenvalues of J (k = 0)
+  double growth0 = 0;                       // sigma(0)
+  bool stable_homogeneous = false;
+  bool hopf = false;
+  bool turing_unstable = false;
+  bool marginal = false;
+  bool oscillatory_fastest = false;
+
+  double k_fastest = 0; // argmax over [0, k_max] of sigma (0 when k = 0 grows fastest)
+  double growth_fastest = 0;
+  double frequency_fastest = 0;
+  double wavelength_fastest = 0; // 2 pi / k_fastest (infinity for k_fastest = 0)
+  bool has_band = false;         // sigma > tol on [k_lo, k_hi], the interval around k_fastest
+  double k_lo = 0, k_hi = 0;
+  bool band_open = false; // the band reaches k_max (sigma still positive there)
+  double k_max = 0;
+  std::vector<DispersionPoint> curve; // the samples, k ascending
+};
+
+// The fastest-growing non-uniform mode of a finite grid (what a simulation shows).
+struct AllowedMode {
+  std::array<long long, 3> m{0, 0, 0}; // mode numbers per axis (m_d >= 0)
+  std::array<double, 3> k{0, 0, 0};    // wave vector components
+  double k_abs = 0, q = 0, growth = 0, frequency = 0;
+  double wavelength = 0; // 2 pi / |k|
+  long long scanned = 0; // number of modes examined
+};
+
+// Eigenvalues of the row-major n x n matrix A, 1 <= n <= 4 (closed form for n = 2 unless
+// general). Returns false if LAPACK fails.
+bool eigenvalues(int n, const double* A, std::complex<double>* out, bool general = false);
+
+// q(k) = -symbol of the grid's Laplacian at wave vector k (|k|^2 without a grid).
+double laplacian_q(const DiscreteGrid* grid, const std::array<double, 3>& k);
+
+// Analysis of a given Jacobian J (N*N, row-major) at a steady state with diffusion D.
+StabilityResult analyse_jacobian(int n, const double* J, const double* D,
+                                 const StabilityOptions& opt = {});
+
+// Analysis of a model: params has entry.nparams values, D entry.nspecies. The state is
+// opt.u_star if given, else entry.steady_state (has_steady_state false if it reports none).
+StabilityResult analyse(const ModelEntry& entry, const std::vector<double>& params,
+                        const std::vector<double>& D, const StabilityOptions& opt = {});
+
+std::vector<double> default_params(const ModelEntry& entry);
+std::vector<double> default_diffusion(const ModelEntry& entry);
+
+// sigma and Im lambda of q for an analysed state (uses r's J, D, dt, eigensolver choice).
+DispersionPoint growth_at_q(const StabilityResult& r, double q);
+
+// Wavenumbers of axis `axis` of a grid: 2 pi m / L (periodic, m = 0..n/2) or pi m / L
+// (zero-flux, m = 0..n-1).
+std::vector<double> allowed_wavenumbers(const DiscreteGrid& grid, int axis);
+
+// The fastest-growing allowed mode with k != 0 over all mode vectors of the grid (every
+// n[d] >= 1; uses the grid's stencil symbol). Ties go to the mode scanned first.
+AllowedMode fastest_allowed_mode(const StabilityResult& r, const DiscreteGrid& grid);
+
+// All homogeneous steady states found by Newton's method from a lattice of starting points in
+// [lo_s, hi_s] per species (defaults: |u| <= 2 max(1, |init_s|, |model u*_s|)), deduplicated,
+// sorted by the first species. The model's own steady_state, if any, is among the starts.
+struct SteadySearch {
+  std::vector<double> lo, hi;
+  int points = 9; // per species
+  int max_it = 60;
+};
+std::vector<std::vector<double>> find_steady_states(const ModelEntry& entry,
+                                                    const std::vector<double>& params,
+                                                    const SteadySearch& search = {});
+
+// One line for logs, e.g. "Turing-unstable: fastest wavelength 17.8 (k 0.353), growth 0.012;
+// unstable band k in [0.21, 0.52]".
+std::string summary(const StabilityResult& r);
+std::string summary(const AllowedMode& m);
+
+} // namespace morphogen::analysis

@@ -1,0 +1,227 @@
+#include "app/run_output.hpp"
+
+#include "core/collective_error.hpp"
+#include "core/log_events.hpp"
+#include "core/stop_signal.hpp"
+#include "io/checkpoint_files.hpp"
+
+#include <hdf5.h>
+
+#include <csignal>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+namespace morphogen {
+
+namespace {
+
+enum : int { kSigUsr1 = 1, kSigTerm = 2, kWallCheckpoint = 4, kWallBudget = 8 };
+
+std::string library_versions(std::string& hdf5) {
+  char petsc[256];
+  PetscGetVersion(petsc, sizeof petsc);
+  unsigned maj = 0, min = 0, rel = 0;
+  H5get_libversion(&maj, &min, &rel);
+  hdf5 = std::to_string(maj) + "." + std::to_string(min) + "." + std::to_string(rel);
+  return petsc;
+}
+
+// Next multiple of `every` strictly after t (with a relative tolerance for rounding).
+double next_multiple(double t, double every) {
+  return (std::floor(t / every * (1 + 1e-12) + 1e-9) + 1) * every;
+}
+
+std::string step_file(const std::string& name, long long step) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "_%07lld.vtkhdf", step);
+  return name + buf;
+}
+
+} // namespace
+
+RunOutput::RunOutput(MPI_Comm comm, const Options& opt) : comm_(comm), opt_(opt) {
+  MPI_Comm_rank(comm, &rank_);
+  MPI_Comm_size(comm, &size_);
+  wall_start_ = MPI_Wtime();
+}
+
+void RunOutput::begin(Simulation& sim, long long restart_step) {
+  const auto& out = sim.output();
+  grid_ = &sim.grid();
+  io_ = std::make_unique<io::VtkHdfIO>(sim.grid());
+  if (!series_) {
+    series_ = std::make_unique<io::SeriesIndex>(out.dir, out.name);
+    if (rank_ == 0) {
+      const auto retired = io::retire_checkpoints_after(out.dir, restart_step);
+      for (const auto& p : retired)
+        std::printf("note: %s is %s: renamed to %s.stale\n", p.c_str(),
+                    restart_step < 0 ? "from an earlier run" : "newer than the restart point",
+                    p.c_str());
+      if (restart_step >= 0) series_->load_existing(restart_step);
+      std::fflush(stdout);
+    }
+  }
+  if (out.checkpoint_every_walltime > 0)
+    next_wall_checkpoint_ = out.checkpoint_every_walltime * 60.0;
+  if (out.snapshot_every_time > 0)
+    next_snapshot_time_ = next_multiple(sim.time(), out.snapshot_every_time);
+  if (out.checkpoint_every_time > 0)
+    next_checkpoint_time_ = next_multiple(sim.time(), out.checkpoint_every_time);
+  last_step_wall_ = MPI_Wtime();
+  const bool periodic = out.snapshot_every > 0 || out.snapshot_every_time > 0;
+  if (restart_step < 0 && sim.level() == 0 && periodic) write_snapshot(sim);
+}
+
+// Rank 0's clock decides the wall-time triggers; a signal on any rank counts. One allreduce.
+int RunOutput::poll_stop_flags(const Simulation& sim) {
+  const auto& out = sim.output();
+  const double now = MPI_Wtime();
+  const double step = now - last_step_wall_;
+  last_step_wall_ = now;
+  step_seconds_ = step_seconds_ == 0 ? step : 0.9 * step_seconds_ + 0.1 * step;
+  int flags = 0;
+  const int sig = stop_signal_received();
+  if (sig == SIGUSR1) flags |= kSigUsr1;
+  if (sig == SIGTERM) flags |= kSigTerm;
+  if (rank_ == 0) {
+    const double wall = now - wall_start_;
+    if (out.checkpoint_every_walltime > 0 && wall >= next_wall_checkpoint_)
+      flags |= kWallCheckpoint;
+    // Stop while there is time for two more steps and a checkpoint write.
+    const double margin = 2 * step_seconds_ + 2 * last_write_seconds_ + 1.0;
+    if (out.max_walltime > 0 && wall + margin >= out.max_walltime * 60.0) flags |= kWallBudget;
+  }
+  MPI_Allreduce(MPI_IN_PLACE, &flags, 1, MPI_INT, MPI_BOR, comm_);
+  return flags;
+}
+
+bool RunOutput::after_step(Simulation& sim) {
+  const auto& out = sim.output();
+  const long long n = sim.step_index();
+  const double t = sim.time(), tol = 1e-9 * sim.dt();
+  bool snap = out.snapshot_every > 0 && n % out.snapshot_every == 0;
+  if (out.snapshot_every_time > 0 && t >= next_snapshot_time_ - tol) {
+    snap = true;
+    next_snapshot_time_ = next_multiple(t, out.snapshot_every_time);
+  }
+  bool check = out.checkpoint_every > 0 && n % out.checkpoint_every == 0;
+  if (out.checkpoint_every_time > 0 && t >= next_checkpoint_time_ - tol) {
+    check = true;
+    next_checkpoint_time_ = next_multiple(t, out.checkpoint_every_time);
+  }
+  const int flags = poll_stop_flags(sim);
+  if (flags & kWallCheckpoint) {
+    check = true;
+    const double wall = MPI_Wtime() - wall_start_;
+    next_wall_checkpoint_ = (std::floor(wall / (out.checkpoint_every_walltime * 60.0)) + 1) *
+                            out.checkpoint_every_walltime * 60.0;
+  }
+  const bool stop = flags & (kSigUsr1 | kSigTerm | kWallBudget);
+  if (snap) write_snapshot(sim);
+  if (check || stop) write_checkpoint(sim);
+  if (!stop) return false;
+  stop_reason_ = (flags & kSigUsr1) ? "SIGUSR1"
+                 : (flags & kSigTerm)
+                     ? "SIGTERM"
+                     : "the -max_walltime budget (" + format_double(out.max_walltime) + " min)";
+  return true;
+}
+
+void RunOutput::finish(Simulation& sim) {
+  write_snapshot(sim);
+  if (sim.output().checkpoint_final) write_checkpoint(sim);
+}
+
+void RunOutput::write_snapshot(Simulation& sim) {
+  const long long n = sim.step_index();
+  if (n == last_snapshot_step_) return;
+  LogScope log_scope(log_events().output);
+  const auto& out = sim.output();
+  const std::string file = step_file(out.name, n);
+  const std::string path = out.dir + "/" + file;
+  io::H5Attributes attrs;
+  attrs.reals = {{"time", sim.time()}};
+  attrs.ints = {{"step", n}};
+  attrs.strings = {{"model", sim.model().name}};
+  std::vector<Vec> fields;
+  for (auto& v : sim.state())
+    fields.push_back(v);
+  const std::string err =
+      io_->write(path + ".tmp", sim.species(), fields, out.snapshot_single, attrs);
+  if (!err.empty()) write_failed("snapshot", path, err);
+  std::string index_err;
+  if (rank_ == 0) {
+    std::error_code ec;
+    std::filesystem::rename(path + ".tmp", path, ec);
+    if (ec) write_failed("snapshot", path, "rename: " + ec.message());
+    std::string why;
+    auto info = io::inspect_vtkhdf(path, why);
+    if (!info) write_failed("snapshot", path, "cannot re-read it: " + why);
+    series_->add({file, n, sim.time(), std::move(*info)});
+    index_err = series_->write();
+    if (!index_err.empty()) write_failed("snapshot index", series_->series_path(), index_err);
+  }
+  last_snapshot_step_ = n;
+}
+
+void RunOutput::write_checkpoint(Simulation& sim) {
+  const long long n = sim.step_index();
+  if (n == last_checkpoint_step_) return;
+  sim.check_finite(); // never checkpoint a diverged state as "good"
+  LogScope log_scope(log_events().output);
+  const double t0 = MPI_Wtime();
+  const auto& out = sim.output();
+  const std::string path = out.dir + "/" + io::checkpoint_file_name(n);
+  std::string hdf5;
+  const std::string petsc = library_versions(hdf5);
+  io::H5Attributes attrs;
+  attrs.reals = {{"time", sim.time()}, {"dt", sim.dt()}};
+  attrs.ints = {{"step", n},
+                {"seed", static_cast<long long>(sim.seed())},
+                {"nranks", size_},
+                {"level", sim.level()},
+                {"complete", 1}};
+  attrs.strings = {{"model", sim.model().name},
+                   {"options", opt_.to_yaml("# Options of the run that wrote this checkpoint\n")},
+                   {"version", MORPHOGEN_VERSION},
+                   {"petsc_version", petsc},
+                   {"hdf5_version", hdf5}};
+  std::vector<Vec> fields;
+  for (auto& v : sim.state())
+    fields.push_back(v);
+  const std::string err = io_->write(path + ".tmp", sim.species(), fields, false, attrs);
+  if (!err.empty()) write_failed("checkpoint", path, err);
+  if (rank_ == 0) {
+    std::error_code ec;
+    std::filesystem::rename(path + ".tmp", path, ec);
+    if (ec) write_failed("checkpoint", path, "rename: " + ec.message());
+    io::prune_checkpoints(out.dir, static_cast<int>(out.checkpoint_keep));
+  }
+  MPI_Barrier(comm_);
+  last_checkpoint_ = path;
+  last_checkpoint_step_ = n;
+  last_write_seconds_ = MPI_Wtime() - t0;
+}
+
+void RunOutput::write_failed(const std::string& what, const std::string& path,
+                             const std::string& err) const {
+  std::error_code ec;
+  std::filesystem::remove(path + ".tmp", ec);
+  std::string msg = err;
+  while (!msg.empty() && (msg.back() == '\n' || msg.back() == ' '))
+    msg.pop_back();
+  for (auto& c : msg)
+    if (c == '\n') c = ' ';
+  std::fprintf(stderr, "morphogen: error: writing %s %s failed (%s); %s\n", what.c_str(),
+               path.c_str(), msg.c_str(),
+               last_checkpoint_.empty()
+                   ? "no checkpoint had been written"
+                   : ("the last good checkpoint " + last_checkpoint_ + " is intact").c_str());
+  std::fflush(stderr);
+  MPI_Abort(comm_, kExitWriteFailed);
+  std::abort();
+}
+
+} // namespace morphogen

@@ -1,0 +1,374 @@
+#include "io/vtkhdf_file.hpp"
+
+#include <hdf5.h>
+#include <nlohmann/json.hpp>
+#include <petscdmda.h>
+#include <petscviewerhdf5.h>
+
+#include <cstring>
+
+namespace morphogen::io {
+
+namespace {
+
+// PETSc error (PETSC_ERR_LIB) when an HDF5 call returns a negative status or id.
+#define MG_H5(...)                                                                                 \
+  do {                                                                                             \
+    if ((__VA_ARGS__) < 0)                                                                         \
+      SETERRQ(PETSC_COMM_SELF, PETSC_ERR_LIB, "HDF5 call failed: %s", #__VA_ARGS__);               \
+  } while (0)
+#define MG_H5_ID(id, ...)                                                                          \
+  do {                                                                                             \
+    (id) = (__VA_ARGS__);                                                                          \
+    if ((id) < 0) SETERRQ(PETSC_COMM_SELF, PETSC_ERR_LIB, "HDF5 call failed: %s", #__VA_ARGS__);   \
+  } while (0)
+
+// HDF5 handle closed on scope exit.
+struct H5Id {
+  hid_t id = -1;
+  herr_t (*close)(hid_t) = nullptr;
+  H5Id(hid_t i, herr_t (*c)(hid_t)) : id(i), close(c) {}
+  H5Id(const H5Id&) = delete;
+  H5Id& operator=(const H5Id&) = delete;
+  ~H5Id() {
+    if (id >= 0 && close) close(id);
+  }
+  bool ok() const { return id >= 0; }
+  operator hid_t() const { return id; }
+};
+
+// Silences HDF5's automatic error-stack printing for the scope (errors are reported by us).
+struct H5Quiet {
+  H5E_auto2_t func = nullptr;
+  void* data = nullptr;
+  H5Quiet() {
+    H5Eget_auto2(H5E_DEFAULT, &func, &data);
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  }
+  ~H5Quiet() { H5Eset_auto2(H5E_DEFAULT, func, data); }
+};
+
+PetscErrorCode write_array_attr(hid_t obj, const char* name, hid_t mem_type, hid_t file_type,
+                                hsize_t n, const void* data) {
+  PetscFunctionBeginUser;
+  hid_t space, attr;
+  MG_H5_ID(space, H5Screate_simple(1, &n, nullptr));
+  MG_H5_ID(attr, H5Acreate2(obj, name, file_type, space, H5P_DEFAULT, H5P_DEFAULT));
+  MG_H5(H5Awrite(attr, mem_type, data));
+  MG_H5(H5Aclose(attr));
+  MG_H5(H5Sclose(space));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode write_scalar_attr(hid_t obj, const char* name, hid_t mem_type, hid_t file_type,
+                                 const void* data) {
+  PetscFunctionBeginUser;
+  hid_t space, attr;
+  MG_H5_ID(space, H5Screate(H5S_SCALAR));
+  MG_H5_ID(attr, H5Acreate2(obj, name, file_type, space, H5P_DEFAULT, H5P_DEFAULT));
+  MG_H5(H5Awrite(attr, mem_type, data));
+  MG_H5(H5Aclose(attr));
+  MG_H5(H5Sclose(space));
+  PetscFunctionReturn(0);
+}
+
+// Fixed-length ASCII string attribute (what VTK's reader expects for /VTKHDF Type).
+PetscErrorCode write_string_attr(hid_t obj, const char* name, const std::string& value) {
+  PetscFunctionBeginUser;
+  hid_t type;
+  MG_H5_ID(type, H5Tcopy(H5T_C_S1));
+  MG_H5(H5Tset_size(type, value.empty() ? 1 : value.size()));
+  MG_H5(H5Tset_strpad(type, H5T_STR_NULLPAD));
+  const std::string padded = value.empty() ? std::string(1, '\0') : value;
+  PetscCall(write_scalar_attr(obj, name, type, type, padded.data()));
+  MG_H5(H5Tclose(type));
+  PetscFunctionReturn(0);
+}
+
+bool read_attr_doubles(hid_t obj, const char* name, double* out, size_t n) {
+  if (H5Aexists(obj, name) <= 0) return false;
+  H5Id a(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose);
+  if (!a.ok()) return false;
+  H5Id s(H5Aget_space(a), H5Sclose);
+  if (H5Sget_simple_extent_npoints(s) != static_cast<hssize_t>(n)) return false;
+  return H5Aread(a, H5T_NATIVE_DOUBLE, out) >= 0;
+}
+
+bool read_attr_ints(hid_t obj, const char* name, long long* out, size_t n) {
+  if (H5Aexists(obj, name) <= 0) return false;
+  H5Id a(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose);
+  if (!a.ok()) return false;
+  H5Id s(H5Aget_space(a), H5Sclose);
+  if (H5Sget_simple_extent_npoints(s) != static_cast<hssize_t>(n)) return false;
+  return H5Aread(a, H5T_NATIVE_LLONG, out) >= 0;
+}
+
+bool read_attr_string(hid_t obj, const char* name, std::string& out) {
+  if (H5Aexists(obj, name) <= 0) return false;
+  H5Id a(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose);
+  if (!a.ok()) return false;
+  H5Id t(H5Aget_type(a), H5Tclose);
+  if (H5Tget_class(t) != H5T_STRING || H5Tis_variable_str(t) > 0) return false;
+  std::vector<char> buf(H5Tget_size(t) + 1, '\0');
+  if (H5Aread(a, t, buf.data()) < 0) return false;
+  out.assign(buf.data());
+  return true;
+}
+
+// Collects the /morphogen attributes by type.
+herr_t collect_attr(hid_t obj, const char* name, const H5A_info_t*, void* data) {
+  auto* attrs = static_cast<H5Attributes*>(data);
+  H5Id a(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose);
+  if (!a.ok()) return 0;
+  H5Id t(H5Aget_type(a), H5Tclose);
+  switch (H5Tget_class(t)) {
+  case H5T_FLOAT: {
+    double v;
+    if (read_attr_doubles(obj, name, &v, 1)) attrs->reals.emplace_back(name, v);
+    break;
+  }
+  case H5T_INTEGER: {
+    long long v;
+    if (read_attr_ints(obj, name, &v, 1)) attrs->ints.emplace_back(name, v);
+    break;
+  }
+  case H5T_STRING: {
+    std::string v;
+    if (read_attr_string(obj, name, v)) attrs->strings.emplace_back(name, v);
+    break;
+  }
+  default:
+    break;
+  }
+  return 0;
+}
+
+herr_t collect_dataset(hid_t group, const char* name, const H5L_info_t*, void* data) {
+  H5O_info_t info;
+  if (H5Oget_info_by_name2(group, name, &info, H5O_INFO_BASIC, H5P_DEFAULT) >= 0 &&
+      info.type == H5O_TYPE_DATASET)
+    static_cast<std::vector<std::string>*>(data)->emplace_back(name);
+  return 0;
+}
+
+} // namespace
+
+const double* H5Attributes::real(const std::string& name) const {
+  for (const auto& [k, v] : reals)
+    if (k == name) return &v;
+  return nullptr;
+}
+const long long* H5Attributes::integer(const std::string& name) const {
+  for (const auto& [k, v] : ints)
+    if (k == name) return &v;
+  return nullptr;
+}
+const std::string* H5Attributes::string(const std::string& name) const {
+  for (const auto& [k, v] : strings)
+    if (k == name) return &v;
+  return nullptr;
+}
+
+std::string ImageInfo::to_json() const {
+  nlohmann::json j;
+  j["n"] = n;
+  j["origin"] = origin;
+  j["spacing"] = spacing;
+  j["arrays"] = arrays;
+  j["precision"] = precision;
+  j["reals"] = attributes.reals;
+  j["ints"] = attributes.ints;
+  j["strings"] = attributes.strings;
+  return j.dump();
+}
+
+ImageInfo ImageInfo::from_json(const std::string& text) {
+  const auto j = nlohmann::json::parse(text);
+  ImageInfo info;
+  info.n = j["n"].get<std::array<long long, 3>>();
+  info.origin = j["origin"].get<std::array<double, 3>>();
+  info.spacing = j["spacing"].get<std::array<double, 3>>();
+  info.arrays = j["arrays"].get<std::vector<std::string>>();
+  info.precision = j["precision"].get<int>();
+  info.attributes.reals = j["reals"].get<std::vector<std::pair<std::string, double>>>();
+  info.attributes.ints = j["ints"].get<std::vector<std::pair<std::string, long long>>>();
+  info.attributes.strings = j["strings"].get<std::vector<std::pair<std::string, std::string>>>();
+  return info;
+}
+
+std::optional<ImageInfo> inspect_vtkhdf(const std::string& path, std::string& why) {
+  H5Quiet quiet;
+  if (H5Fis_hdf5(path.c_str()) <= 0) {
+    FILE* f = std::fopen(path.c_str(), "rb");
+    why = f ? "not a readable HDF5 file (truncated or corrupt)" : "no such file";
+    if (f) std::fclose(f);
+    return std::nullopt;
+  }
+  H5Id file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  if (!file.ok()) {
+    why = "HDF5 cannot open it (truncated or corrupt)";
+    return std::nullopt;
+  }
+  if (H5Lexists(file, "VTKHDF", H5P_DEFAULT) <= 0) {
+    why = "no /VTKHDF group (not a VTKHDF file)";
+    return std::nullopt;
+  }
+  H5Id vtk(H5Gopen2(file, "VTKHDF", H5P_DEFAULT), H5Gclose);
+  std::string type;
+  long long extent[6];
+  ImageInfo info;
+  if (!vtk.ok() || !read_attr_string(vtk, "Type", type) || type != "ImageData" ||
+      !read_attr_ints(vtk, "WholeExtent", extent, 6) ||
+      !read_attr_doubles(vtk, "Origin", info.origin.data(), 3) ||
+      !read_attr_doubles(vtk, "Spacing", info.spacing.data(), 3)) {
+    why = "/VTKHDF is not ImageData with WholeExtent, Origin and Spacing";
+    return std::nullopt;
+  }
+  for (int d = 0; d < 3; ++d)
+    info.n[d] = extent[2 * d + 1] - extent[2 * d] + 1;
+  if (H5Lexists(vtk, "PointData", H5P_DEFAULT) > 0) {
+    H5Id pd(H5Gopen2(vtk, "PointData", H5P_DEFAULT), H5Gclose);
+    if (pd.ok()) H5Literate(pd, H5_INDEX_NAME, H5_ITER_INC, nullptr, collect_dataset, &info.arrays);
+    for (size_t a = 0; a < info.arrays.size(); ++a) {
+      H5Id ds(H5Dopen2(pd, info.arrays[a].c_str(), H5P_DEFAULT), H5Dclose);
+      H5Id sp(ds.ok() ? H5Dget_space(ds) : -1, H5Sclose);
+      hsize_t dims[4] = {0, 0, 0, 0};
+      if (!sp.ok() || H5Sget_simple_extent_ndims(sp) != 3 ||
+          H5Sget_simple_extent_dims(sp, dims, nullptr) != 3 ||
+          static_cast<long long>(dims[0]) != info.n[2] ||
+          static_cast<long long>(dims[1]) != info.n[1] ||
+          static_cast<long long>(dims[2]) != info.n[0]) {
+        why = "dataset /VTKHDF/PointData/" + info.arrays[a] + " does not match WholeExtent";
+        return std::nullopt;
+      }
+      if (a == 0) {
+        H5Id t(H5Dget_type(ds), H5Tclose);
+        info.precision = static_cast<int>(H5Tget_size(t));
+      }
+    }
+  }
+  if (H5Lexists(file, "morphogen", H5P_DEFAULT) > 0) {
+    H5Id mg(H5Gopen2(file, "morphogen", H5P_DEFAULT), H5Gclose);
+    if (mg.ok()) {
+      hsize_t idx = 0;
+      H5Aiterate2(mg, H5_INDEX_NAME, H5_ITER_INC, &idx, collect_attr, &info.attributes);
+    }
+  }
+  return info;
+}
+
+VtkHdfIO::VtkHdfIO(const Grid& grid) : grid_(grid) {
+  PetscInt procs[3] = {1, 1, 1};
+  MG_PETSC(DMDAGetInfo(grid.dm(), nullptr, nullptr, nullptr, nullptr, &procs[0], &procs[1],
+                       &procs[2], nullptr, nullptr, nullptr, nullptr, nullptr, nullptr));
+  const auto ranges = grid.ownership_ranges();
+  const PetscInt one = 1;
+  const auto& n = grid.spec().n;
+  MG_PETSC(DMDACreate3d(grid.comm(), DM_BOUNDARY_NONE, DM_BOUNDARY_NONE, DM_BOUNDARY_NONE,
+                        DMDA_STENCIL_STAR, n[0], n[1], grid.dim() == 3 ? n[2] : 1, procs[0],
+                        procs[1], grid.dim() == 3 ? procs[2] : 1, 1, 0, ranges[0].data(),
+                        ranges[1].data(), grid.dim() == 3 ? ranges[2].data() : &one, dm3_.out()));
+  MG_PETSC(DMSetUp(dm3_));
+  MG_PETSC(DMCreateGlobalVector(dm3_, io_.out()));
+}
+
+PetscErrorCode VtkHdfIO::copy_owned(Vec local, Vec io, bool to_io) const {
+  PetscFunctionBeginUser;
+  const Box& ob = grid_.owned();
+  PetscScalar *l, *g;
+  PetscCall(VecGetArray(local, &l));
+  PetscCall(VecGetArray(io, &g));
+  const size_t row = static_cast<size_t>(ob.m[0]) * sizeof(PetscScalar);
+  for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
+    for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j) {
+      PetscScalar* lr = l + grid_.local_index(ob.s[0], j, k);
+      PetscScalar* gr = g + grid_.owned_index(ob.s[0], j, k);
+      if (to_io)
+        std::memcpy(gr, lr, row);
+      else
+        std::memcpy(lr, gr, row);
+    }
+  PetscCall(VecRestoreArray(io, &g));
+  PetscCall(VecRestoreArray(local, &l));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode VtkHdfIO::write_impl(const std::string& path, const std::vector<std::string>& names,
+                                    const std::vector<Vec>& fields, bool single_precision,
+                                    const H5Attributes& attributes) const {
+  PetscFunctionBeginUser;
+  PetscViewer v;
+  PetscCall(PetscViewerHDF5Open(grid_.comm(), path.c_str(), FILE_MODE_WRITE, &v));
+  PetscCall(PetscViewerHDF5SetSPOutput(v, single_precision ? PETSC_TRUE : PETSC_FALSE));
+  PetscCall(PetscViewerHDF5PushGroup(v, "/VTKHDF/PointData"));
+  for (size_t s = 0; s < fields.size(); ++s) {
+    PetscCall(copy_owned(fields[s], io_, true));
+    PetscCall(PetscObjectSetName(reinterpret_cast<PetscObject>(io_.get()), names[s].c_str()));
+    PetscCall(VecView(io_, v));
+  }
+  PetscCall(PetscViewerHDF5PopGroup(v));
+
+  hid_t file, vtk, mg;
+  PetscCall(PetscViewerHDF5GetFileId(v, &file));
+  MG_H5_ID(vtk, H5Gopen2(file, "/VTKHDF", H5P_DEFAULT));
+  const auto& sp = grid_.spec();
+  const int version[2] = {1, 0};
+  int extent[6] = {0, 0, 0, 0, 0, 0};
+  double origin[3] = {0, 0, 0}, spacing[3] = {sp.h(0), sp.h(1), sp.h(0)};
+  const double direction[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  for (int d = 0; d < grid_.dim(); ++d) {
+    extent[2 * d + 1] = static_cast<int>(sp.n[d] - 1);
+    origin[d] = 0.5 * sp.h(d);
+    spacing[d] = sp.h(d);
+  }
+  PetscCall(write_array_attr(vtk, "Version", H5T_NATIVE_INT, H5T_STD_I32LE, 2, version));
+  PetscCall(write_string_attr(vtk, "Type", "ImageData"));
+  PetscCall(write_array_attr(vtk, "WholeExtent", H5T_NATIVE_INT, H5T_STD_I32LE, 6, extent));
+  PetscCall(write_array_attr(vtk, "Origin", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 3, origin));
+  PetscCall(write_array_attr(vtk, "Spacing", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 3, spacing));
+  PetscCall(write_array_attr(vtk, "Direction", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 9, direction));
+  MG_H5(H5Gclose(vtk));
+
+  MG_H5_ID(mg, H5Gcreate2(file, "/morphogen", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+  for (const auto& [k, val] : attributes.reals)
+    PetscCall(write_scalar_attr(mg, k.c_str(), H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, &val));
+  for (const auto& [k, val] : attributes.ints)
+    PetscCall(write_scalar_attr(mg, k.c_str(), H5T_NATIVE_LLONG, H5T_STD_I64LE, &val));
+  for (const auto& [k, val] : attributes.strings)
+    PetscCall(write_string_attr(mg, k.c_str(), val));
+  MG_H5(H5Gclose(mg));
+  PetscCall(PetscViewerDestroy(&v));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode VtkHdfIO::read_impl(const std::string& path, const std::vector<std::string>& names,
+                                   const std::vector<Vec>& fields) const {
+  PetscFunctionBeginUser;
+  PetscViewer v;
+  PetscCall(PetscViewerHDF5Open(grid_.comm(), path.c_str(), FILE_MODE_READ, &v));
+  PetscCall(PetscViewerHDF5PushGroup(v, "/VTKHDF/PointData"));
+  for (size_t s = 0; s < fields.size(); ++s) {
+    PetscCall(PetscObjectSetName(reinterpret_cast<PetscObject>(io_.get()), names[s].c_str()));
+    PetscCall(VecLoad(io_, v));
+    PetscCall(copy_owned(fields[s], io_, false));
+  }
+  PetscCall(PetscViewerHDF5PopGroup(v));
+  PetscCall(PetscViewerDestroy(&v));
+  PetscFunctionReturn(0);
+}
+
+std::string VtkHdfIO::write(const std::string& path, const std::vector<std::string>& names,
+                            const std::vector<Vec>& fields, bool single_precision,
+                            const H5Attributes& attributes) const {
+  H5Quiet quiet;
+  return petsc_quietly(
+      [&] { return write_impl(path, names, fields, single_precision, attributes); });
+}
+
+std::string VtkHdfIO::read(const std::string& path, const std::vector<std::string>& names,
+                           const std::vector<Vec>& fields) const {
+  H5Quiet quiet;
+  return petsc_quietly([&] { return read_impl(path, names, fields); });
+}
+
+} // namespace morphogen::io
