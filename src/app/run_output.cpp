@@ -8,6 +8,7 @@
 #include <hdf5.h>
 
 #include <csignal>
+#include <sys/statvfs.h>
 
 #include <cmath>
 #include <cstdio>
@@ -210,6 +211,10 @@ void RunOutput::write_failed(const std::string& what, const std::string& path,
   std::error_code ec;
   std::filesystem::remove(path + ".tmp", ec);
   std::string msg = err;
+  struct statvfs fs {};
+  if (statvfs(grid_ ? std::filesystem::path(path).parent_path().c_str() : ".", &fs) == 0 &&
+      fs.f_bavail * fs.f_frsize < (1u << 20))
+    msg += "; " + std::to_string(fs.f_bavail * fs.f_frsize / 1024) + " KiB free on its device";
   while (!msg.empty() && (msg.back() == '\n' || msg.back() == ' '))
     msg.pop_back();
   for (auto& c : msg)

@@ -59,14 +59,30 @@ namespace morphogen {
 // Run PETSc calls with errors returned instead of printed as a trace, for errors caused by
 // user input (an unparsable deck, a grid too small for the rank count). Returns PETSc's
 // message, or "" on success.
+// PETSc error handler that keeps the innermost error's message (ctx: std::string*).
+inline PetscErrorCode petsc_capture_error(MPI_Comm, int, const char*, const char*,
+                                          PetscErrorCode n, PetscErrorType, const char* mess,
+                                          void* ctx) {
+  auto* out = static_cast<std::string*>(ctx);
+  if (out->empty() && mess) {
+    *out = mess;
+    while (!out->empty() && (out->back() == '\n' || out->back() == ' '))
+      out->pop_back();
+  }
+  return n;
+}
+
 template <class F> std::string petsc_quietly(F&& f) {
-  PetscPushErrorHandler(PetscReturnErrorHandler, nullptr);
+  std::string detail;
+  PetscPushErrorHandler(petsc_capture_error, &detail);
   const PetscErrorCode ierr = f();
   PetscPopErrorHandler();
   if (!ierr) return {};
   const char* text = nullptr;
   PetscErrorMessage(ierr, &text, nullptr);
-  return text ? text : "error";
+  std::string msg = text ? text : "error";
+  if (!detail.empty() && detail != msg) msg += ": " + detail;
+  return msg;
 }
 } // namespace morphogen
 
