@@ -1,6 +1,7 @@
 // morphogen: MPI-distributed reaction-diffusion (Turing pattern) solver.
 //
 //   morphogen [DECK.yaml] [-option value ...]
+//   morphogen sweep DECK.yaml [-option value ...]     (phase-diagram sweep, sweep/sweep_main.hpp)
 //
 // Loads the deck (or the embedded default, Sanderson Fig. 1) into PETSc's options database,
 // overrides it with the command line, validates every option (unknown options fail with a
@@ -15,6 +16,7 @@
 #include "core/collective_error.hpp"
 #include "core/stop_signal.hpp"
 #include "core/user_error.hpp"
+#include "sweep/sweep_main.hpp"
 
 #include <cstdio>
 #include <filesystem>
@@ -169,7 +171,8 @@ int main(int argc, char** argv) {
   install_stop_signal_handlers();
   int rc = 0;
   try {
-    rc = run(&argc, &argv);
+    rc = argc > 1 && std::string(argv[1]) == "sweep" ? sweep::run_sweep(&argc, &argv)
+                                                     : run(&argc, &argv);
   } catch (const UserError& e) {
     PetscFPrintf(PETSC_COMM_WORLD, PETSC_STDERR, "morphogen: error: %s\n", e.what());
     rc = 1;

@@ -71,6 +71,7 @@ public:
   const Stencil& stencil() const { return stencil_; }
   std::uint64_t seed() const { return seed_; }
   int level() const { return level_index_; }
+  const ParamSet& params() const { return params_; }
   // Set the clock after loading a checkpoint into state() (then call refresh_ghosts()).
   void set_clock(double t, PetscInt step) {
     t_ = t;

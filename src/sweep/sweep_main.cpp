@@ -1,0 +1,236 @@
+#include "sweep/sweep_main.hpp"
+
+#include "analysis/linear_stability.hpp"
+#include "app/deck.hpp"
+#include "app/simulation.hpp"
+#include "core/collective_error.hpp"
+#include "core/user_error.hpp"
+#include "io/series_index.hpp"
+#include "sweep/point_record.hpp"
+#include "sweep/point_runner.hpp"
+#include "sweep/sweep_table.hpp"
+#include "sweep/work_queue.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+namespace morphogen::sweep {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Setup {
+  SweepSpec spec;
+  SweepSettings set;
+  int group_size = 1;
+  long long chunk = 0, chunks = 1;
+};
+
+Setup read_setup(Options& opt, const std::string& base_dir) {
+  Setup s;
+  const auto axes = opt.list("sweep_axes", {}, 1, 3,
+                             "options swept (1 to 3), e.g. params_F,params_k; each needs "
+                             "-sweep_<option> with its values");
+  for (const auto& a : axes) {
+    if (std::count(axes.begin(), axes.end(), a) > 1)
+      throw UserError("-sweep_axes: " + a + " is given twice");
+    const std::string key = "sweep_" + a;
+    const auto text = opt.get(key, "values of " + a +
+                                       ": linspace(a, b, n), logspace(a, b, n), "
+                                       "range(a, b, step) or v1,v2,...");
+    if (!text) throw UserError("-" + key + ": missing (the values of sweep axis " + a + ")");
+    Axis ax;
+    ax.option = a;
+    ax.values = parse_axis_values(key, *text);
+    for (const auto& v : ax.values)
+      ax.numbers.push_back(Options::parse_real(key, v));
+    s.spec.axes.push_back(std::move(ax));
+    s.set.known.push_back(key);
+  }
+  if (s.spec.points() > 10000000) throw UserError("-sweep_axes: more than 10^7 points");
+  s.group_size = static_cast<int>(
+      opt.integer("sweep_group_size", 1, 1, 1 << 20, "ranks per sweep point (divides the ranks)"));
+  s.chunks = opt.integer("sweep_chunks", 1, 1, 1 << 30,
+                         "split the sweep into this many chunks (job arrays)");
+  s.chunk = opt.integer("sweep_chunk", 0, 0, 1 << 30,
+                        "run only chunk c (0-based): the points p with p mod chunks == c");
+  if (s.chunk >= s.chunks)
+    throw UserError("-sweep_chunk " + std::to_string(s.chunk) + ": must be < -sweep_chunks (" +
+                    std::to_string(s.chunks) + ")");
+  s.set.species = opt.string("sweep_species", "",
+                             "species the metrics and class are computed on (default: the "
+                             "model's first)");
+  s.set.samples = opt.integer("sweep_samples", 100, 4, 100000,
+                              "time-series samples per point (for steady / periodic / chaotic)");
+  s.set.base_dir = base_dir;
+  for (const char* k : {"sweep_axes", "sweep_group_size", "sweep_chunks", "sweep_chunk",
+                        "sweep_species", "sweep_samples"})
+    s.set.known.emplace_back(k);
+  return s;
+}
+
+// Every rank, on PETSC_COMM_SELF: build the simulation of every axis value (others at their
+// first value) so a bad value fails before anything runs. Returns the first point's options.
+std::string validate(const Setup& s, std::string& dir) {
+  std::string yaml;
+  const size_t na = s.spec.axes.size();
+  for (size_t a = 0; a < na; ++a)
+    for (size_t v = 0; v < s.spec.axes[a].values.size(); ++v) {
+      if (a > 0 && v == 0) continue;
+      for (size_t b = 0; b < na; ++b)
+        MG_PETSC(PetscOptionsSetValue(
+            nullptr, ("-" + s.spec.axes[b].option).c_str(),
+            (b == a ? s.spec.axes[b].values[v] : s.spec.axes[b].values[0]).c_str()));
+      Options opt(PETSC_COMM_SELF);
+      for (const auto& k : s.set.known)
+        opt.known(k);
+      Simulation sim(PETSC_COMM_SELF, opt, s.set.base_dir);
+      if (!s.set.species.empty()) {
+        const auto& n = sim.species();
+        if (std::find(n.begin(), n.end(), s.set.species) == n.end())
+          throw UserError("-sweep_species " + s.set.species + ": no such species in model " +
+                          sim.model().name);
+      }
+      if (a == 0 && v == 0) {
+        opt.check_unused();
+        dir = sim.output().dir;
+        yaml = opt.to_yaml("");
+      }
+    }
+  return yaml;
+}
+
+std::vector<long long> finished_points(const std::string& dir, long long n) {
+  std::vector<long long> done;
+  std::error_code ec;
+  for (fs::directory_iterator it(dir + "/points", ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string f = it->path().filename().string();
+    long long p = -1;
+    char tail[8] = "";
+    if (std::sscanf(f.c_str(), "point_%lld.%7s", &p, tail) == 2 && std::string(tail) == "json" &&
+        p >= 0 && p < n && f == point_file(p, "json"))
+      done.push_back(p);
+  }
+  return done;
+}
+
+} // namespace
+
+int run_sweep(int* argc, char*** argv) {
+  MPI_Comm world = PETSC_COMM_WORLD;
+  int rank = 0;
+  MPI_Comm_rank(world, &rank);
+  // Drop "sweep": the deck becomes argv[1].
+  for (int i = 1; i + 1 < *argc; ++i)
+    (*argv)[i] = (*argv)[i + 1];
+  --*argc;
+  if (*argc < 2 || (*argv)[1][0] == '-')
+    throw UserError("sweep: needs a deck (morphogen sweep DECK.yaml [-option value ...])");
+  const std::string base_dir = load_deck(argc, argv);
+  Options sopt(world);
+  Setup s = read_setup(sopt, base_dir);
+  std::string dir;
+  const std::string yaml = validate(s, dir);
+  s.set.dir = dir;
+  const long long npoints = s.spec.points();
+
+  // Output directory, options and the list of points still to run.
+  std::string err;
+  std::vector<long long> todo;
+  if (rank == 0) {
+    std::error_code ec;
+    fs::create_directories(dir + "/points", ec);
+    if (ec)
+      err = "-output_dir " + dir + ": cannot create " + dir + "/points (" + ec.message() + ")";
+    else
+      err = io::write_file_atomically(
+          dir + "/options_used.yaml",
+          "# Options of this sweep (morphogen " MORPHOGEN_VERSION ")\n" + sopt.to_yaml("") + yaml);
+    if (!err.empty()) err = "-output_dir " + dir + ": " + err;
+    const auto done = finished_points(dir, npoints);
+    for (long long p = s.chunk; p < npoints; p += s.chunks)
+      if (std::find(done.begin(), done.end(), p) == done.end()) todo.push_back(p);
+    std::printf(
+        "sweep: %lld points (%s), chunk %lld/%lld: %zu to run, %zu already done -> %s/\n", npoints,
+        [&] {
+          std::string a;
+          for (const auto& ax : s.spec.axes)
+            a +=
+                (a.empty() ? "" : " x ") + ax.option + "[" + std::to_string(ax.values.size()) + "]";
+          return a;
+        }()
+            .c_str(),
+        s.chunk, s.chunks, todo.size(), done.size(), dir.c_str());
+    std::fflush(stdout);
+  }
+  throw_if_any(world, err);
+  long long ntodo = static_cast<long long>(todo.size());
+  MPI_Bcast(&ntodo, 1, MPI_LONG_LONG, 0, world);
+  todo.resize(static_cast<size_t>(ntodo));
+  MPI_Bcast(todo.data(), static_cast<int>(ntodo), MPI_LONG_LONG, 0, world);
+
+  WorkQueue q(world, s.group_size, todo);
+  const double t0 = MPI_Wtime();
+  double cell_updates = 0;
+  long long ran = 0;
+  bool interrupted = false;
+  for (long long p = q.next(); p >= 0; p = q.next()) {
+    const nlohmann::json r = run_point(s.spec, p, s.set, q, interrupted);
+    if (interrupted) {
+      // Stop handing out points; wait for the others to finish theirs.
+      while (q.next() >= 0) {
+      }
+      break;
+    }
+    if (q.leader()) {
+      const std::string jerr =
+          io::write_file_atomically(dir + "/points/" + point_file(p, "json"), r.dump(1) + "\n");
+      if (!jerr.empty()) {
+        std::fprintf(stderr, "morphogen: error: %s\n", jerr.c_str());
+        MPI_Abort(world, 4);
+      }
+      cell_updates += r["cells"].get<double>() * r["steps"].get<double>();
+      ++ran;
+      std::string params;
+      for (const auto& [k, v] : r["params"].items())
+        params += (params.empty() ? "" : " ") + k + "=" + format_double(v.get<double>());
+      std::printf("point %lld [%s]: %s (wavelength %s), %.2f s, group %d\n", p, params.c_str(),
+                  r["class"].get<std::string>().c_str(),
+                  r["metrics"]["wavelength"].is_null()
+                      ? "-"
+                      : std::to_string(r["metrics"]["wavelength"].get<double>()).c_str(),
+                  r["runtime_s"].get<double>(), q.group_index());
+      std::fflush(stdout);
+    }
+  }
+  q.drain();
+  const double wall = MPI_Wtime() - t0;
+  double totals[2] = {cell_updates, static_cast<double>(ran)};
+  MPI_Allreduce(MPI_IN_PLACE, totals, 2, MPI_DOUBLE, MPI_SUM, world);
+  int any_interrupted = interrupted;
+  MPI_Allreduce(MPI_IN_PLACE, &any_interrupted, 1, MPI_INT, MPI_LOR, world);
+  if (rank == 0) {
+    const std::string terr = write_sweep_table(dir, s.spec, yaml);
+    if (!terr.empty()) {
+      std::fprintf(stderr, "morphogen: error: %s\n", terr.c_str());
+      MPI_Abort(world, 4);
+    }
+    std::printf("sweep: ran %.0f points in %.2f s on %d group%s: %.3e cell-updates/s aggregate; "
+                "table %s/sweep.csv\n",
+                totals[1], wall, q.groups(), q.groups() == 1 ? "" : "s",
+                wall > 0 ? totals[0] / wall : 0.0, dir.c_str());
+    std::fflush(stdout);
+  }
+  if (any_interrupted) {
+    PetscPrintf(world, "sweep: stopped by a signal; run the same command again to finish the "
+                       "remaining points (exit code 3)\n");
+    return 3;
+  }
+  return 0;
+}
+
+} // namespace morphogen::sweep

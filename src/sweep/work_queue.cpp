@@ -1,0 +1,78 @@
+#include "sweep/work_queue.hpp"
+
+#include "core/user_error.hpp"
+
+namespace morphogen::sweep {
+
+namespace {
+constexpr int kTagRequest = 7101, kTagAssign = 7102;
+}
+
+WorkQueue::WorkQueue(MPI_Comm world, int group_size, std::vector<long long> todo)
+    : world_(world), todo_(std::move(todo)) {
+  int size = 1;
+  MPI_Comm_rank(world, &world_rank_);
+  MPI_Comm_size(world, &size);
+  if (group_size < 1 || size % group_size != 0)
+    throw UserError("-sweep_group_size " + std::to_string(group_size) +
+                    ": must divide the number of ranks (" + std::to_string(size) + ")");
+  ngroups_ = size / group_size;
+  group_index_ = world_rank_ / group_size;
+  MPI_Comm_split(world, group_index_, world_rank_, &group_);
+  MPI_Comm_rank(group_, &group_rank_);
+}
+
+WorkQueue::~WorkQueue() {
+  if (group_ != MPI_COMM_NULL) MPI_Comm_free(&group_);
+}
+
+long long WorkQueue::take() {
+  return cursor_ < todo_.size() ? todo_[cursor_++] : -1;
+}
+
+long long WorkQueue::next() {
+  long long p = -1;
+  if (group_rank_ == 0) {
+    if (world_rank_ == 0) {
+      poll();
+      p = take();
+    } else {
+      int dummy = 0;
+      MPI_Send(&dummy, 1, MPI_INT, 0, kTagRequest, world_);
+      MPI_Recv(&p, 1, MPI_LONG_LONG, 0, kTagAssign, world_, MPI_STATUS_IGNORE);
+    }
+  }
+  MPI_Bcast(&p, 1, MPI_LONG_LONG, 0, group_);
+  return p;
+}
+
+void WorkQueue::poll() {
+  if (world_rank_ != 0) return;
+  while (true) {
+    int flag = 0;
+    MPI_Status st;
+    MPI_Iprobe(MPI_ANY_SOURCE, kTagRequest, world_, &flag, &st);
+    if (!flag) return;
+    int dummy = 0;
+    MPI_Recv(&dummy, 1, MPI_INT, st.MPI_SOURCE, kTagRequest, world_, MPI_STATUS_IGNORE);
+    const long long p = take();
+    if (p < 0) ++stopped_leaders_;
+    MPI_Send(&p, 1, MPI_LONG_LONG, st.MPI_SOURCE, kTagAssign, world_);
+  }
+}
+
+void WorkQueue::drain() {
+  if (world_rank_ == 0) {
+    while (stopped_leaders_ < ngroups_ - 1) {
+      MPI_Status st;
+      int dummy = 0;
+      MPI_Recv(&dummy, 1, MPI_INT, MPI_ANY_SOURCE, kTagRequest, world_, &st);
+      const long long p = take();
+      if (p < 0) ++stopped_leaders_;
+      MPI_Send(&p, 1, MPI_LONG_LONG, st.MPI_SOURCE, kTagAssign, world_);
+    }
+  }
+  MPI_Barrier(world_);
+}
+
+} // namespace morphogen::sweep
