@@ -85,8 +85,8 @@ nlohmann::json stability_json(const analysis::StabilityResult& r,
                       {"wave", r.oscillatory_fastest},
                       {"growth_fastest", num(r.growth_fastest)},
                       {"wavelength_fastest", num(r.wavelength_fastest)}};
-  if (mode) {
-    j["wavelength_allowed"] = num(mode->wavelength);
+  if (mode) { // the predicted pattern wavelength only where a pattern is predicted
+    j["wavelength_allowed"] = r.turing_unstable ? num(mode->wavelength) : nlohmann::json();
     j["growth_allowed"] = num(mode->growth);
   }
   return j;

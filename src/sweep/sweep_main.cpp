@@ -54,6 +54,11 @@ Setup read_setup(Options& opt, const std::string& base_dir) {
   if (s.spec.points() > 10000000) throw UserError("-sweep_axes: more than 10^7 points");
   s.group_size = static_cast<int>(
       opt.integer("sweep_group_size", 1, 1, 1 << 20, "ranks per sweep point (divides the ranks)"));
+  int world_size = 1;
+  MPI_Comm_size(PETSC_COMM_WORLD, &world_size);
+  if (world_size % s.group_size != 0)
+    throw UserError("-sweep_group_size " + std::to_string(s.group_size) +
+                    ": must divide the number of ranks (" + std::to_string(world_size) + ")");
   s.chunks = opt.integer("sweep_chunks", 1, 1, 1 << 30,
                          "split the sweep into this many chunks (job arrays)");
   s.chunk = opt.integer("sweep_chunk", 0, 0, 1 << 30,
