@@ -148,7 +148,7 @@ int run(int* argc, char*** argv) {
                   rp->path.c_str(), rp->step, rp->time, *rp->info.attributes.integer("nranks"),
                   *rp->info.attributes.integer("nranks") == 1 ? "" : "s");
     }
-    output.begin(*sim, restarting ? rp->step : (l == 0 ? -1 : sim->step_index()));
+    output.begin(*sim, restarting ? rp->step : (l == 0 ? -1 : sim->step_index()), end);
     print_header(comm, *sim, l, levels);
     if (run_loop(*sim, end, output, l + 1 == levels)) return kExitResubmit;
     prev = std::move(sim);

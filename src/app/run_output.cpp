@@ -48,7 +48,7 @@ RunOutput::RunOutput(MPI_Comm comm, const Options& opt) : comm_(comm), opt_(opt)
   wall_start_ = MPI_Wtime();
 }
 
-void RunOutput::begin(Simulation& sim, long long restart_step) {
+void RunOutput::begin(Simulation& sim, long long restart_step, PetscInt end_step) {
   const auto& out = sim.output();
   grid_ = &sim.grid();
   io_ = std::make_unique<io::VtkHdfIO>(sim.grid());
@@ -71,6 +71,9 @@ void RunOutput::begin(Simulation& sim, long long restart_step) {
   if (out.checkpoint_every_time > 0)
     next_checkpoint_time_ = next_multiple(sim.time(), out.checkpoint_every_time);
   last_step_wall_ = MPI_Wtime();
+  sampler_ = FieldSampler();
+  sample_every_ = std::max<PetscInt>(1, (end_step - sim.step_index()) / 100);
+  if (out.summary) sampler_.take(sim);
   const bool periodic = out.snapshot_every > 0 || out.snapshot_every_time > 0;
   if (restart_step < 0 && sim.level() == 0 && periodic) write_snapshot(sim);
 }
@@ -112,6 +115,7 @@ bool RunOutput::after_step(Simulation& sim) {
     check = true;
     next_checkpoint_time_ = next_multiple(t, out.checkpoint_every_time);
   }
+  if (out.summary && n % sample_every_ == 0) sampler_.take(sim);
   const int flags = poll_stop_flags(sim);
   if (flags & kWallCheckpoint) {
     check = true;
@@ -133,6 +137,29 @@ bool RunOutput::after_step(Simulation& sim) {
 void RunOutput::finish(Simulation& sim) {
   write_snapshot(sim);
   if (sim.output().checkpoint_final) write_checkpoint(sim);
+  if (!sim.output().summary) return;
+  nlohmann::json species = nlohmann::json::object();
+  for (size_t s = 0; s < sim.species().size(); ++s) {
+    nlohmann::json c =
+        classify_species(sim, static_cast<int>(s),
+                         sampler_.count() >= 4 ? &sampler_.samples(static_cast<int>(s)) : nullptr);
+    if (rank_ == 0) species[sim.species()[s]] = std::move(c);
+  }
+  nlohmann::json stability = stability_record(sim);
+  if (rank_ != 0) return;
+  nlohmann::json j = {{"model", sim.model().name},
+                      {"step", static_cast<long long>(sim.step_index())},
+                      {"time", sim.time()},
+                      {"species", species},
+                      {"stability", stability}};
+  const std::string path = sim.output().dir + "/summary.json";
+  const std::string err = io::write_file_atomically(path, j.dump(1) + "\n");
+  if (!err.empty()) write_failed("summary", path, err);
+  std::string line;
+  for (const auto& [name, c] : species.items())
+    line += (line.empty() ? "" : ", ") + name + ": " + c["class"].get<std::string>();
+  std::printf("pattern (summary.json): %s\n", line.c_str());
+  std::fflush(stdout);
 }
 
 void RunOutput::write_snapshot(Simulation& sim) {

@@ -9,6 +9,7 @@
 // rank with exit code 4 (an HDF5 write that failed on one rank cannot be finished collectively).
 #pragma once
 
+#include "app/pattern_summary.hpp"
 #include "app/simulation.hpp"
 #include "io/series_index.hpp"
 #include "io/vtkhdf_file.hpp"
@@ -28,10 +29,12 @@ public:
   // Start writing for a (new level's) simulation. restart_step < 0: a fresh run (checkpoints
   // of an earlier run in the directory are retired, the series starts empty); otherwise the run
   // continues from that step (later checkpoints are retired, later series entries dropped).
-  void begin(Simulation& sim, long long restart_step);
+  void begin(Simulation& sim, long long restart_step, PetscInt end_step);
   // After every step. Returns true when the run must stop (a checkpoint has been written).
   bool after_step(Simulation& sim);
-  // Final snapshot and checkpoint of the last level.
+  // Final snapshot and checkpoint of the last level, and summary.json: per species the pattern
+  // class and metrics (with the run's dynamics from samples taken every 1/100 of the run),
+  // and the linear stability of the parameters.
   void finish(Simulation& sim);
 
   const std::string& last_checkpoint() const { return last_checkpoint_; }
@@ -55,6 +58,8 @@ private:
   double next_snapshot_time_ = 0, next_checkpoint_time_ = 0;
   long long last_snapshot_step_ = -1, last_checkpoint_step_ = -1;
   std::string last_checkpoint_, stop_reason_;
+  FieldSampler sampler_;
+  PetscInt sample_every_ = 0;
 };
 
 } // namespace morphogen

@@ -403,6 +403,9 @@ void Simulation::read_snapshot_options(Options& opt) {
       opt.integer("checkpoint_keep", 2, 1, 1000000, "number of most recent checkpoints kept");
   out_.checkpoint_final =
       opt.flag("checkpoint_final", true, "write a checkpoint of the final state (to extend a run)");
+  out_.summary = opt.flag("summary", true,
+                          "write summary.json at the end: pattern class and metrics per species "
+                          "(2-D; the middle z slice in 3-D) and linear stability");
 }
 
 void Simulation::step() {

@@ -38,6 +38,7 @@ struct OutputSettings {
   double max_walltime = 0;              // minutes: checkpoint and exit 3 before this
   PetscInt checkpoint_keep = 2;
   bool checkpoint_final = true;
+  bool summary = true; // summary.json: pattern class, metrics and stability at the end
 };
 
 class Simulation;

@@ -1,0 +1,209 @@
+#include "app/pattern_summary.hpp"
+
+#include "analysis/classify.hpp"
+#include "analysis/linear_stability.hpp"
+#include "analysis/pattern_metrics.hpp"
+#include "core/user_error.hpp"
+#include "io/slice_gather.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace morphogen {
+
+namespace {
+
+nlohmann::json num(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
+}
+
+nlohmann::json phase_json(const analysis::PhaseMetrics& p) {
+  return {{"area_fraction", num(p.area_fraction)},
+          {"components", p.components},
+          {"specks", p.specks},
+          {"spots", p.spots},
+          {"spot_area", num(p.spot_area)},
+          {"spot_area_cells", num(p.spot_area_cells)},
+          {"elongated", p.elongated},
+          {"wrapping", p.wrapping},
+          {"networks", p.networks},
+          {"spot_area_fraction", num(p.spot_area_fraction)},
+          {"elongated_area_fraction", num(p.elongated_area_fraction)},
+          {"largest_fraction", num(p.largest_fraction)},
+          {"median_elongation", num(p.median_elongation)},
+          {"median_fill", num(p.median_fill)}};
+}
+
+nlohmann::json metrics_json(const analysis::PatternMetrics& m) {
+  return {{"finite", m.finite},
+          {"min", num(m.min)},
+          {"max", num(m.max)},
+          {"mean", num(m.mean)},
+          {"stddev", num(m.stddev)},
+          {"contrast", num(m.contrast)},
+          {"wavelength", num(m.wavelength)},
+          {"wavelength_cells", num(m.wavelength_cells)},
+          {"peak_sharpness", num(m.peak_sharpness)},
+          {"spectral_anisotropy", num(m.spectral_anisotropy)},
+          {"coherence", num(m.coherence)},
+          {"threshold", num(m.threshold)},
+          {"euler", m.euler},
+          {"high", phase_json(m.high)},
+          {"low", phase_json(m.low)}};
+}
+
+nlohmann::json verdict_json(const analysis::RunVerdict& v) {
+  return {{"behaviour", analysis::to_string(v.behaviour)},
+          {"period", num(v.period)},
+          {"moving", v.moving},
+          {"late_change", num(v.late_change)}};
+}
+
+} // namespace
+
+void FieldSampler::take(Simulation& sim) {
+  const Grid& g = sim.grid();
+  const size_t ns = sim.state().size();
+  if (samples_.empty()) {
+    samples_.resize(ns);
+    prev_.resize(ns);
+  }
+  const Box& ob = g.owned();
+  const auto& n = g.spec().n;
+  const PetscInt ci = n[0] / 2, cj = n[1] / 2, ck = g.dim() == 3 ? n[2] / 2 : 0;
+  // Per species: sum, sum of squares, sum of squared change, probe.
+  std::vector<double> acc(4 * ns, 0.0);
+  const bool first = prev_[0].empty();
+  for (size_t s = 0; s < ns; ++s) {
+    auto& prev = prev_[s];
+    if (first) prev.resize(static_cast<size_t>(ob.size()));
+    double* a4 = &acc[4 * s];
+    const PetscScalar* a;
+    MG_PETSC(VecGetArrayRead(sim.state()[s], &a));
+    for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
+      for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j)
+        for (PetscInt i = ob.s[0]; i < ob.s[0] + ob.m[0]; ++i) {
+          const double v = a[g.local_index(i, j, k)];
+          double& p = prev[static_cast<size_t>(g.owned_index(i, j, k))];
+          a4[0] += v;
+          a4[1] += v * v;
+          a4[2] += first ? 0.0 : (v - p) * (v - p);
+          p = v;
+          if (i == ci && j == cj && k == ck) a4[3] = v;
+        }
+    MG_PETSC(VecRestoreArrayRead(sim.state()[s], &a));
+  }
+  MPI_Allreduce(MPI_IN_PLACE, acc.data(), static_cast<int>(acc.size()), MPI_DOUBLE, MPI_SUM,
+                g.comm());
+  const double cells = static_cast<double>(g.global_cells());
+  for (size_t s = 0; s < ns; ++s) {
+    const double* a4 = &acc[4 * s];
+    const double mean = a4[0] / cells;
+    auto& r = samples_[s];
+    r.t.push_back(sim.time());
+    r.mean.push_back(mean);
+    r.stddev.push_back(std::sqrt(std::max(0.0, a4[1] / cells - mean * mean)));
+    r.change.push_back(first ? std::nan("") : std::sqrt(a4[2]) / (std::sqrt(a4[1]) + 1e-300));
+    r.probe.push_back(a4[3]);
+  }
+}
+
+nlohmann::json classify_species(Simulation& sim, int species, const analysis::RunSamples* samples,
+                                const std::string& diverged) {
+  const Grid& g = sim.grid();
+  const PetscInt kz = g.dim() == 3 ? g.spec().n[2] / 2 : 0;
+  const PetscScalar* a;
+  MG_PETSC(VecGetArrayRead(sim.state()[species], &a));
+  std::vector<double> field = io::gather_xy_slice(g, a, kz);
+  MG_PETSC(VecRestoreArrayRead(sim.state()[species], &a));
+  int rank = 0;
+  MPI_Comm_rank(g.comm(), &rank);
+  if (rank != 0) return {};
+  analysis::FieldShape2D shape;
+  shape.nx = static_cast<int>(g.spec().n[0]);
+  shape.ny = static_cast<int>(g.spec().n[1]);
+  shape.hx = g.spec().h(0);
+  shape.hy = g.spec().h(1);
+  shape.periodic_x = g.spec().bc[0] == Boundary::Periodic;
+  shape.periodic_y = g.spec().bc[1] == Boundary::Periodic;
+  const analysis::PatternMetrics m = analysis::compute_pattern_metrics(field.data(), shape);
+  nlohmann::json r;
+  analysis::Classification c;
+  if (samples && samples->t.size() >= 4) {
+    const analysis::RunVerdict v = analysis::classify_run(*samples);
+    c = analysis::classify(m, &v);
+    r["dynamics"] = verdict_json(v);
+  } else {
+    c = analysis::classify(m, nullptr);
+  }
+  if (!diverged.empty()) {
+    c.cls = analysis::PatternClass::blowup;
+    c.reason = diverged;
+  }
+  r["class"] = analysis::to_string(c.cls);
+  r["reason"] = c.reason;
+  r["metrics"] = metrics_json(m);
+  return r;
+}
+
+nlohmann::json stability_record(const Simulation& sim) {
+  const auto& ps = sim.params();
+  const Grid& g = sim.grid();
+  // A parameter that varies in space (a noisy value, a ramp) is analysed at its spatial mean.
+  std::vector<double> p = ps.scalar;
+  std::vector<std::string> averaged;
+  for (size_t q = 0; q < p.size(); ++q) {
+    if (!ps.field[q].get()) continue;
+    PetscScalar sum = 0;
+    MG_PETSC(VecSum(ps.field[q], &sum));
+    p[q] = sum / static_cast<double>(g.global_cells());
+    averaged.push_back(ps.names[q]);
+  }
+  analysis::DiscreteGrid dg;
+  dg.dim = g.dim();
+  for (int d = 0; d < 3; ++d) {
+    dg.h[d] = g.spec().h(d);
+    dg.n[d] = d < g.dim() ? g.spec().n[d] : 1;
+    dg.periodic[d] = g.spec().bc[d] == Boundary::Periodic;
+  }
+  dg.stencil = sim.stencil().name;
+  analysis::StabilityOptions so;
+  so.grid = dg;
+  try {
+    const auto r = analysis::analyse(sim.model(), p, sim.diffusion(), so);
+    nlohmann::json j = {{"has_steady_state", r.has_steady_state},
+                        {"u_star", r.u_star},
+                        {"stable_homogeneous", r.stable_homogeneous},
+                        {"turing_unstable", r.turing_unstable},
+                        {"hopf", r.hopf},
+                        {"wave", r.oscillatory_fastest},
+                        {"growth_fastest", num(r.growth_fastest)},
+                        {"wavelength_fastest", num(r.wavelength_fastest)}};
+    if (r.has_steady_state) {
+      // The predicted pattern wavelength only where a pattern is predicted.
+      const auto mode = analysis::fastest_allowed_mode(r, dg);
+      j["wavelength_allowed"] = r.turing_unstable ? num(mode.wavelength) : nlohmann::json();
+      j["growth_allowed"] = num(mode.growth);
+    }
+    if (!averaged.empty()) j["parameters_averaged"] = averaged;
+    return j;
+  } catch (const UserError& e) {
+    return {{"error", e.what()}};
+  }
+}
+
+nlohmann::json samples_json(const analysis::RunSamples& s) {
+  auto arr = [](const std::vector<double>& v) {
+    nlohmann::json a = nlohmann::json::array();
+    for (double x : v)
+      a.push_back(num(x));
+    return a;
+  };
+  return {{"t", arr(s.t)},
+          {"mean", arr(s.mean)},
+          {"stddev", arr(s.stddev)},
+          {"change", arr(s.change)},
+          {"probe", arr(s.probe)}};
+}
+
+} // namespace morphogen

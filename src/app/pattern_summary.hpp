@@ -1,0 +1,47 @@
+// What a run's pattern is, for summary.json and for sweep records:
+//  - FieldSampler: cheap metrics of every species sampled during the run (spatial mean and
+//    standard deviation, L2 change relative to the field since the previous sample, the value
+//    at the centre cell), one allreduce per sample;
+//  - classify_species: the final field of one species (2-D, or the middle z slice in 3-D)
+//    gathered to rank 0, its pattern metrics (analysis/pattern_metrics.hpp), the run's dynamics
+//    from the samples (analysis/time_series.hpp) and the class (analysis/classify.hpp);
+//  - stability_record: linear (Turing/Hopf) stability of the run's parameters (spatial means
+//    where they vary) on its grid (analysis/linear_stability.hpp), with the fastest-growing
+//    wavelength the grid allows.
+// JSON has no infinities or NaN: such values are stored as null.
+#pragma once
+
+#include "analysis/time_series.hpp"
+#include "app/simulation.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <vector>
+
+namespace morphogen {
+
+class FieldSampler {
+public:
+  // Collective: appends one sample of every species.
+  void take(Simulation& sim);
+  const analysis::RunSamples& samples(int species) const { return samples_[species]; }
+  size_t count() const { return samples_.empty() ? 0 : samples_[0].t.size(); }
+
+private:
+  std::vector<analysis::RunSamples> samples_;
+  std::vector<std::vector<double>> prev_;
+};
+
+// Collective. On rank 0: {"class", "reason", "metrics", "dynamics"}; elsewhere null.
+// samples may be null (class from the final field only). diverged: the run's NaN message
+// (class blowup).
+nlohmann::json classify_species(Simulation& sim, int species, const analysis::RunSamples* samples,
+                                const std::string& diverged = "");
+
+// Collective. Parameters that vary in space are analysed at their spatial means (listed in
+// "parameters_averaged").
+nlohmann::json stability_record(const Simulation& sim);
+
+nlohmann::json samples_json(const analysis::RunSamples& s);
+
+} // namespace morphogen
