@@ -4,8 +4,6 @@
 #include "core/user_error.hpp"
 #include "operators/stencil.hpp"
 
-#include <petscblaslapack.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -168,16 +166,91 @@ bool eigenvalues(int n, const double* A, std::complex<double>* out, bool general
     }
     return true;
   }
-  // LAPACK is column-major: it sees A^T, which has the same eigenvalues.
-  double a[kMaxSpecies * kMaxSpecies], wr[kMaxSpecies], wi[kMaxSpecies], vdum[1],
-      work[16 * kMaxSpecies];
-  std::copy(A, A + n * n, a);
-  PetscBLASInt nb = n, lda = n, one = 1, lwork = 16 * kMaxSpecies, info = 0;
-  LAPACKgeev_("N", "N", &nb, a, &lda, wr, wi, vdum, &one, vdum, &one, work, &lwork, &info);
-  if (info != 0) return false;
+  // General path: the characteristic polynomial of A / ||A|| (Faddeev-LeVerrier), its roots
+  // by Aberth-Ehrlich iteration. Accuracy ~1e-15 ||A|| for simple roots, ~1e-8 ||A|| for
+  // double and ~1e-5 ||A|| for triple ones (polynomial roots are that ill-conditioned).
+  double scale = inf_norm(n, A);
+  if (!(scale > 0)) {
+    for (int i = 0; i < n; ++i)
+      out[i] = 0;
+    return true;
+  }
+  if (!std::isfinite(scale)) return false;
+  double B[kMaxSpecies * kMaxSpecies], M[kMaxSpecies * kMaxSpecies] = {},
+                                                       T[kMaxSpecies * kMaxSpecies];
+  for (int i = 0; i < n * n; ++i)
+    B[i] = A[i] / scale;
+  double c[kMaxSpecies + 1]; // p(z) = sum_i c[i] z^i, c[n] = 1
+  c[n] = 1;
+  for (int k = 1; k <= n; ++k) {
+    // M <- B M + c[n-k+1] I ; c[n-k] = -tr(B M) / k
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        double s = 0;
+        for (int l = 0; l < n; ++l)
+          s += B[i * n + l] * M[l * n + j];
+        T[i * n + j] = s + (i == j ? c[n - k + 1] : 0.0);
+      }
+    std::copy(T, T + n * n, M);
+    double tr = 0;
+    for (int i = 0; i < n; ++i)
+      for (int l = 0; l < n; ++l)
+        tr += B[i * n + l] * M[l * n + i];
+    c[n - k] = -tr / k;
+  }
+  auto eval = [&](std::complex<double> z, std::complex<double>& dp) {
+    std::complex<double> p = c[n];
+    dp = 0;
+    for (int i = n - 1; i >= 0; --i) {
+      dp = dp * z + p;
+      p = p * z + c[i];
+    }
+    return p;
+  };
+  double radius = 0;
   for (int i = 0; i < n; ++i)
-    out[i] = {wr[i], wi[i]};
+    radius = std::max(radius, std::abs(c[i]));
+  radius = 1 + radius; // Cauchy bound
+  std::complex<double> z[kMaxSpecies];
+  for (int i = 0; i < n; ++i)
+    z[i] = std::polar(0.5 * radius, 2 * kPi * i / n + 0.4);
+  int polish = 2; // iterations after the steps fall to round-off level (cubic convergence)
+  for (int it = 0; it < 200 && polish > 0; ++it) {
+    double moved = 0;
+    for (int i = 0; i < n; ++i) {
+      std::complex<double> dp;
+      const std::complex<double> p = eval(z[i], dp);
+      if (p == 0.0) continue;
+      const std::complex<double> ratio = p / dp;
+      std::complex<double> sum = 0;
+      for (int j = 0; j < n; ++j)
+        if (j != i) sum += 1.0 / (z[i] - z[j]);
+      const std::complex<double> w = ratio / (1.0 - ratio * sum);
+      if (!std::isfinite(w.real()) || !std::isfinite(w.imag())) continue;
+      z[i] -= w;
+      moved = std::max(moved, std::abs(w) / std::max(1.0, std::abs(z[i])));
+    }
+    if (moved < 1e-13) --polish;
+  }
+  // Real coefficients: roots are real or conjugate pairs; drop round-off imaginary parts.
+  for (int i = 0; i < n; ++i) {
+    if (!std::isfinite(z[i].real()) || !std::isfinite(z[i].imag())) return false;
+    if (std::abs(z[i].imag()) <= 1e-12 * std::max(1.0, std::abs(z[i]))) z[i].imag(0);
+    out[i] = z[i] * scale;
+  }
   return true;
+}
+
+DiscreteGrid discrete_grid(const GridSpec& spec, const std::string& stencil) {
+  DiscreteGrid g;
+  g.dim = spec.dim;
+  g.stencil = stencil;
+  for (int d = 0; d < 3; ++d) {
+    g.h[d] = d < spec.dim ? spec.h(d) : 1.0;
+    g.n[d] = d < spec.dim ? spec.n[d] : 1;
+    g.periodic[d] = spec.bc[d] == Boundary::Periodic;
+  }
+  return g;
 }
 
 double laplacian_q(const DiscreteGrid* grid, const std::array<double, 3>& k) {
@@ -217,7 +290,7 @@ StabilityResult analyse_jacobian(int n, const double* J, const double* D,
   // k = 0: the kinetics alone.
   r.eigen0.resize(n);
   if (!eigenvalues(n, J, r.eigen0.data(), opt.general_eigensolver))
-    throw UserError("linear stability: the eigenvalue computation (LAPACK dgeev) failed");
+    throw UserError("linear stability: the eigenvalue computation failed (non-finite Jacobian?)");
   r.growth0 = -std::numeric_limits<double>::infinity();
   for (const auto& l : r.eigen0) {
     const double g = rate_of(l, opt.dt);
@@ -239,8 +312,7 @@ StabilityResult analyse_jacobian(int n, const double* J, const double* D,
     c /= std::sqrt(norm);
   Stencil st;
   if (opt.grid) st = stencil_of(*opt.grid);
-  const Dispersion disp{n, r.jacobian.data(), r.diffusion.data(), opt.dt,
-                        opt.general_eigensolver};
+  const Dispersion disp{n, r.jacobian.data(), r.diffusion.data(), opt.dt, opt.general_eigensolver};
   auto point = [&](double k) {
     const std::array<double, 3> kv{k * e[0], k * e[1], k * e[2]};
     DispersionPoint p = disp.at(opt.grid ? q_of(st, *opt.grid, kv) : k * k);
@@ -254,7 +326,8 @@ StabilityResult analyse_jacobian(int n, const double* J, const double* D,
     if (opt.grid) {
       r.k_max = std::numeric_limits<double>::infinity();
       for (int d = 0; d < dim; ++d)
-        if (std::abs(e[d]) > 1e-12) r.k_max = std::min(r.k_max, kPi / (opt.grid->h[d] * std::abs(e[d])));
+        if (std::abs(e[d]) > 1e-12)
+          r.k_max = std::min(r.k_max, kPi / (opt.grid->h[d] * std::abs(e[d])));
     } else {
       double dmin = std::numeric_limits<double>::infinity();
       for (int s = 0; s < n; ++s)
@@ -265,11 +338,15 @@ StabilityResult analyse_jacobian(int n, const double* J, const double* D,
   }
   const int ns = opt.samples;
   r.curve.resize(ns);
-  int imax = 0;
+  double gmax = -std::numeric_limits<double>::infinity();
   for (int i = 0; i < ns; ++i) {
     r.curve[i] = point(r.k_max * i / (ns - 1));
-    if (r.curve[i].growth > r.curve[imax].growth) imax = i;
+    gmax = std::max(gmax, r.curve[i].growth);
   }
+  // The first sample within round-off of the maximum (flat curves: the smallest k).
+  int imax = 0;
+  while (imax + 1 < ns && !(r.curve[imax].growth >= gmax - 1e-3 * r.tol))
+    ++imax;
 
   // Refine the maximum inside the bracket of the best sample; keep an end if it is higher.
   const double ktol = opt.k_tol * r.k_max;
@@ -277,12 +354,13 @@ StabilityResult analyse_jacobian(int n, const double* J, const double* D,
   double kbest = golden_max(growth, a, b, ktol);
   for (double kc : {a, b, r.curve[imax].k})
     if (growth(kc) > growth(kbest)) kbest = kc;
+  // Ties within round-off (flat curves, a maximum at k = 0): the smaller k.
+  if (growth(a) >= growth(kbest) - 1e-3 * r.tol) kbest = a;
   const DispersionPoint best = point(kbest);
   r.k_fastest = best.k;
   r.growth_fastest = best.growth;
   r.frequency_fastest = best.frequency;
-  r.wavelength_fastest =
-      best.k > 0 ? 2 * kPi / best.k : std::numeric_limits<double>::infinity();
+  r.wavelength_fastest = best.k > 0 ? 2 * kPi / best.k : std::numeric_limits<double>::infinity();
   r.oscillatory_fastest = best.k > 0 && best.frequency > r.tol;
   r.marginal = std::abs(best.growth) <= r.tol;
   r.turing_unstable = r.stable_homogeneous && best.growth > r.tol && best.k > 0;
@@ -425,15 +503,31 @@ std::vector<std::vector<double>> find_steady_states(const ModelEntry& entry,
   const bool has_own = entry.steady_state(params.data(), own.data());
   std::vector<double> lo(n), hi(n);
   for (int s = 0; s < n; ++s) {
-    const double h = 2 * std::max({1.0, std::abs(entry.species[s].init),
-                                   has_own ? std::abs(own[s]) : 0.0});
+    const double h =
+        2 * std::max({1.0, std::abs(entry.species[s].init), has_own ? std::abs(own[s]) : 0.0});
     lo[s] = s < static_cast<int>(search.lo.size()) ? search.lo[s] : -h;
     hi[s] = s < static_cast<int>(search.hi.size()) ? search.hi[s] : h;
   }
-  const int pts = std::max(search.points, 1);
+  static constexpr int auto_points[kMaxSpecies + 1] = {1, 65, 17, 9, 7};
+  const int pts = search.points > 0 ? search.points : auto_points[n];
   long long starts = 1;
   for (int s = 0; s < n; ++s)
     starts *= pts;
+
+  auto start = [&](long long c) {
+    std::vector<double> u(n);
+    for (int s = 0; s < n; ++s, c /= pts)
+      u[s] = pts == 1 ? 0.5 * (lo[s] + hi[s]) : lo[s] + (hi[s] - lo[s]) * (c % pts) / (pts - 1);
+    return u;
+  };
+  // Residual scale: the largest |R| over the starts (a root must be 1e-10 of it).
+  double rscale = 1;
+  for (long long c = 0; c < starts; ++c) {
+    double R[kMaxSpecies];
+    entry.rates(start(c).data(), params.data(), R);
+    for (int s = 0; s < n; ++s)
+      if (std::isfinite(R[s])) rscale = std::max(rscale, std::abs(R[s]));
+  }
 
   std::vector<std::vector<double>> found;
   auto newton = [&](std::vector<double> u) {
@@ -452,35 +546,30 @@ std::vector<std::vector<double>> find_steady_states(const ModelEntry& entry,
       if (step <= 1e-15 * (1 + max_abs(u))) break;
     }
     entry.rates(u.data(), params.data(), R);
-    entry.jacobian(u.data(), params.data(), J);
     double res = 0;
     for (int s = 0; s < n; ++s)
       res = std::max(res, std::abs(R[s]));
-    if (!std::isfinite(res) || res > 1e-10 * (1 + inf_norm(n, J) * max_abs(u))) return;
+    if (!std::isfinite(res) || res > 1e-10 * rscale) return;
+    // Newton converges only linearly to a double root (a fold): 1e-5 merges its copies.
     for (const auto& v : found) {
       double d = 0;
       for (int s = 0; s < n; ++s)
         d = std::max(d, std::abs(u[s] - v[s]));
-      if (d <= 1e-7 * (1 + max_abs(u))) return;
+      if (d <= 1e-5 * (1 + max_abs(u))) return;
     }
     found.push_back(u);
   };
   if (has_own) newton(own);
-  for (long long c = 0; c < starts; ++c) {
-    std::vector<double> u(n);
-    long long idx = c;
-    for (int s = 0; s < n; ++s, idx /= pts)
-      u[s] = pts == 1 ? 0.5 * (lo[s] + hi[s]) : lo[s] + (hi[s] - lo[s]) * (idx % pts) / (pts - 1);
-    newton(u);
-  }
+  for (long long c = 0; c < starts; ++c)
+    newton(start(c));
   std::sort(found.begin(), found.end());
   return found;
 }
 
 std::string summary(const StabilityResult& r) {
   if (!r.has_steady_state) return "no homogeneous steady state";
-  const std::string fastest = "fastest wavelength " + fmt("%.3g", r.wavelength_fastest) +
-                              " (k " + fmt("%.3g", r.k_fastest) + "), growth " +
+  const std::string fastest = "fastest wavelength " + fmt("%.3g", r.wavelength_fastest) + " (k " +
+                              fmt("%.3g", r.k_fastest) + "), growth " +
                               fmt("%.3g", r.growth_fastest);
   std::string band;
   if (r.has_band)
@@ -502,8 +591,9 @@ std::string summary(const StabilityResult& r) {
                                                    fmt("%.3g", r.frequency_fastest) + "): "
                                              : "Turing-unstable: ") +
            fastest + band;
-  if (r.marginal)
-    return "marginal (on the instability threshold): " + fastest;
+  if (r.marginal) return "marginal (on the instability threshold): " + fastest;
+  if (r.k_fastest == 0)
+    return "stable: slowest decay " + fmt("%.3g", r.growth_fastest) + " (uniform mode, k = 0)";
   return "stable: slowest decay " + fmt("%.3g", r.growth_fastest) + " at k " +
          fmt("%.3g", r.k_fastest) + " (wavelength " + fmt("%.3g", r.wavelength_fastest) + ")";
 }

@@ -14,17 +14,23 @@
 // The growth rate of k is sigma(k) = max Re lambda(A(q(k))); with dt > 0 it is instead the rate
 // of the forward Euler map u <- (I + dt A) u, ln|1 + dt lambda| / dt (what the explicit
 // integrator does). The dispersion curve is sampled on k in [0, k_max] along a direction and its
-// maximum refined by golden-section search. Classification (tol = zero_tol * ||J||_inf):
+// maximum refined by golden-section search (ties within round-off go to the smaller k, so a
+// curve that is flat or falls from k = 0 reports k_fastest = 0). Classification, with the rates
+// above (Re lambda, or the Euler rate when dt > 0) and tol = zero_tol * ||J||_inf:
 //   stable_homogeneous  every Re lambda(A(0)) < -tol
 //   hopf                A(0) has a complex pair (|Im| > tol) with Re > tol
 //   turing_unstable     stable_homogeneous and max_{k>0} sigma(k) > tol
 //   marginal            |max_k sigma(k)| <= tol (on a Turing or Hopf threshold)
 //   oscillatory_fastest the fastest k > 0 has |Im lambda| > tol (wave instability)
-// Eigenvalues: closed form for N = 2, LAPACK dgeev otherwise. Pure computation: no MPI, no
-// PETSc objects; bad input (sizes, unknown stencil) throws UserError.
+// Eigenvalues: closed form for N = 2; otherwise the roots of the characteristic polynomial
+// (Faddeev-LeVerrier, Aberth-Ehrlich iteration) - LAPACK's dgeev is not used because
+// morphogen_core does not link LAPACK directly (PETSc's pkg-config gives only -lpetsc).
+// Pure computation: no MPI, no PETSc objects; bad input (sizes, unknown stencil) throws
+// UserError.
 #pragma once
 
 #include "app/model_registry.hpp"
+#include "grid/grid.hpp"
 
 #include <array>
 #include <complex>
@@ -45,17 +51,22 @@ struct DiscreteGrid {
   std::string stencil = "5pt";
 };
 
+// The analysis grid of a run: spacing, cells and stencil; periodic axes as such, zero-flux and
+// Dirichlet axes as zero-flux (Dirichlet's sine modes have the same k = pi m / L but m >= 1;
+// and its boundary values generally differ from u*, so the analysis is only indicative there).
+DiscreteGrid discrete_grid(const GridSpec& spec, const std::string& stencil);
+
 struct StabilityOptions {
   std::optional<DiscreteGrid> grid;         // none: the continuous Laplacian, q = |k|^2
   std::array<double, 3> direction{1, 0, 0}; // direction of k for the curve (grid symbol only)
-  double k_max = 0;      // 0: the grid's Nyquist pi/h along direction, or, continuous,
-                         //    3 sqrt(||J||_inf / min positive D) (a few times the fastest k)
-  int samples = 1024;    // sampled points of the dispersion curve on [0, k_max]
-  double k_tol = 1e-10;  // golden-section / bisection tolerance, relative to k_max
-  double dt = 0;         // > 0: rates of the forward Euler step, ln|1 + dt lambda| / dt
-  double zero_tol = 1e-9; // relative to ||J||_inf: below it a rate counts as zero
+  double k_max = 0;           // 0: the grid's Nyquist pi/h along direction, or, continuous,
+                              //    3 sqrt(||J||_inf / min positive D) (a few times the fastest k)
+  int samples = 1024;         // sampled points of the dispersion curve on [0, k_max]
+  double k_tol = 1e-10;       // golden-section / bisection tolerance, relative to k_max
+  double dt = 0;              // > 0: rates of the forward Euler step, ln|1 + dt lambda| / dt
+  double zero_tol = 1e-9;     // relative to ||J||_inf: below it a rate counts as zero
   std::vector<double> u_star; // analyse this state instead of the model's steady_state
-  bool general_eigensolver = false; // LAPACK even for N = 2 (used by the tests)
+  bool general_eigensolver = false; // the general path even for N = 2 (used by the tests)
 };
 
 struct DispersionPoint {
@@ -104,7 +115,8 @@ struct AllowedMode {
 };
 
 // Eigenvalues of the row-major n x n matrix A, 1 <= n <= 4 (closed form for n = 2 unless
-// general). Returns false if LAPACK fails.
+// general). Returns false for non-finite input. The general path is accurate to ~1e-15 ||A||
+// for simple eigenvalues, ~1e-8 ||A|| for double and ~1e-5 ||A|| for triple ones.
 bool eigenvalues(int n, const double* A, std::complex<double>* out, bool general = false);
 
 // q(k) = -symbol of the grid's Laplacian at wave vector k (|k|^2 without a grid).
@@ -130,15 +142,19 @@ DispersionPoint growth_at_q(const StabilityResult& r, double q);
 std::vector<double> allowed_wavenumbers(const DiscreteGrid& grid, int axis);
 
 // The fastest-growing allowed mode with k != 0 over all mode vectors of the grid (every
-// n[d] >= 1; uses the grid's stencil symbol). Ties go to the mode scanned first.
+// n[d] >= 1; uses the grid's stencil symbol). Ties go to the mode scanned first. Cost: one
+// small eigenproblem per mode with m_d >= 0, (n/2 + 1)^dim of them (8192^2: ~1 s).
 AllowedMode fastest_allowed_mode(const StabilityResult& r, const DiscreteGrid& grid);
 
-// All homogeneous steady states found by Newton's method from a lattice of starting points in
-// [lo_s, hi_s] per species (defaults: |u| <= 2 max(1, |init_s|, |model u*_s|)), deduplicated,
-// sorted by the first species. The model's own steady_state, if any, is among the starts.
+// Homogeneous steady states R(u) = 0 found by Newton's method from a lattice of starting points
+// in [lo_s, hi_s] per species (defaults: |u_s| <= 2 max(1, |init_s|, |model u*_s|)) and from the
+// model's own steady_state. A root is accepted when max |R| <= 1e-10 max(1, max |R| over the
+// starts); roots closer than 1e-5 (relative) are merged (Newton is only linear at a fold).
+// Sorted lexicographically. A search, not a proof: a state outside the box or with a tiny basin
+// can be missed.
 struct SteadySearch {
-  std::vector<double> lo, hi;
-  int points = 9; // per species
+  std::vector<double> lo, hi; // per species; empty: the defaults above
+  int points = 0;             // per species; 0: 65, 17, 9, 7 for 1, 2, 3, 4 species
   int max_it = 60;
 };
 std::vector<std::vector<double>> find_steady_states(const ModelEntry& entry,
