@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace morphogen {
 
@@ -170,7 +171,8 @@ nlohmann::json stability_record(const Simulation& sim) {
   analysis::StabilityOptions so;
   so.grid = dg;
   try {
-    const auto r = analysis::analyse(sim.model(), p, sim.diffusion(), so);
+    int states = 0;
+    const auto r = analyse_states(sim.model(), p, sim.diffusion(), so, &states);
     nlohmann::json j = {{"has_steady_state", r.has_steady_state},
                         {"u_star", r.u_star},
                         {"stable_homogeneous", r.stable_homogeneous},
@@ -185,11 +187,31 @@ nlohmann::json stability_record(const Simulation& sim) {
       j["wavelength_allowed"] = r.turing_unstable ? num(mode.wavelength) : nlohmann::json();
       j["growth_allowed"] = num(mode.growth);
     }
+    j["steady_states"] = states;
     if (!averaged.empty()) j["parameters_averaged"] = averaged;
     return j;
   } catch (const UserError& e) {
     return {{"error", e.what()}};
   }
+}
+
+analysis::StabilityResult analyse_states(const ModelEntry& model, const std::vector<double>& params,
+                                         const std::vector<double>& D,
+                                         const analysis::StabilityOptions& so, int* states) {
+  analysis::StabilityResult own = analysis::analyse(model, params, D, so);
+  const auto all = analysis::find_steady_states(model, params);
+  if (states) *states = static_cast<int>(all.size());
+  std::optional<analysis::StabilityResult> hopf;
+  if (own.turing_unstable) return own;
+  for (const auto& u : all) {
+    analysis::StabilityOptions o = so;
+    o.u_star = u;
+    analysis::StabilityResult r = analysis::analyse(model, params, D, o);
+    if (r.turing_unstable) return r;
+    if (r.hopf && !hopf) hopf = std::move(r);
+  }
+  if (own.hopf || !hopf) return own;
+  return *hopf;
 }
 
 nlohmann::json samples_json(const analysis::RunSamples& s) {

@@ -11,6 +11,7 @@
 // JSON has no infinities or NaN: such values are stored as null.
 #pragma once
 
+#include "analysis/linear_stability.hpp"
 #include "analysis/time_series.hpp"
 #include "app/simulation.hpp"
 
@@ -43,5 +44,13 @@ nlohmann::json classify_species(Simulation& sim, int species, const analysis::Ru
 nlohmann::json stability_record(const Simulation& sim);
 
 nlohmann::json samples_json(const analysis::RunSamples& s);
+
+// Linear stability of (params, D): every homogeneous steady state that find_steady_states
+// finds, plus the model's own, is analysed; the one reported is the first Turing-unstable
+// state, else the first with a Hopf instability, else the model's own steady state (so a
+// multistable model like Gray-Scott reports the pattern-forming branch). states: how many.
+analysis::StabilityResult analyse_states(const ModelEntry& model, const std::vector<double>& params,
+                                         const std::vector<double>& D,
+                                         const analysis::StabilityOptions& so, int* states);
 
 } // namespace morphogen

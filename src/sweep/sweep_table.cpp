@@ -1,6 +1,7 @@
 #include "sweep/sweep_table.hpp"
 
 #include "analysis/linear_stability.hpp"
+#include "app/pattern_summary.hpp"
 #include "app/simulation.hpp"
 #include "io/series_index.hpp"
 #include "sweep/point_record.hpp"
@@ -74,7 +75,7 @@ nlohmann::json stability_map(const SweepSpec& spec) {
     axes.push_back(refined(a.numbers, refine));
     total *= axes.back().size();
   }
-  if (total > 200000) return {};
+  if (total > 40000) return {};
   nlohmann::json turing = nlohmann::json::array(), hopf = nlohmann::json::array(),
                  wl = nlohmann::json::array();
   for (size_t p = 0; p < total; ++p) {
@@ -84,7 +85,7 @@ nlohmann::json stability_map(const SweepSpec& spec) {
       r /= axes[a].size();
     }
     try {
-      const auto st = analysis::analyse(m, params, D, so);
+      const auto st = analyse_states(m, params, D, so, nullptr);
       turing.push_back(st.turing_unstable);
       hopf.push_back(st.hopf);
       wl.push_back(st.turing_unstable && std::isfinite(st.wavelength_fastest)
