@@ -1,0 +1,552 @@
+"""The cluster job scripts in jobs/: shellcheck-clean, and their restart/resubmit logic run
+without a cluster. Fake srun/mpiexec, sbatch/qsub, squeue/scontrol/qstat executables on PATH
+record what the scripts ask of the batch system; a resubmission is followed by running the
+recorded submission (script, arguments, environment) as the next job of the chain. The last
+test drives the real morphogen binary through a checkpoint on SIGUSR1 and a restart."""
+import glob
+import os
+import shutil
+import signal
+import subprocess
+import time
+
+import pytest
+
+SOURCE = os.path.abspath(os.environ.get("MORPHOGEN_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "../..")))
+JOBS = os.path.join(SOURCE, "jobs")
+EXE = os.environ.get("MORPHOGEN_EXE", os.path.join(SOURCE, "build", "morphogen"))
+MPIEXEC = shutil.which(os.environ.get("MORPHOGEN_MPIEXEC", "mpiexec")) or "mpiexec"  # before the fakes go on PATH
+DECK = os.path.join(SOURCE, "input", "turing_spots.yaml")
+SCRIPTS = sorted(glob.glob(os.path.join(JOBS, "*.sbatch")) + glob.glob(os.path.join(JOBS, "*.pbs"))
+                 + glob.glob(os.path.join(JOBS, "*.sh")))
+
+# Fake srun / mpiexec: records its arguments (one per line) and the signals it gets; exit code of
+# call n is the n-th word of FAKE_EXIT_CODES (the last one repeats). With FAKE_WAIT_SIGNAL=1 it
+# waits for FAKE_SIGNALS_NEEDED (default 1) signals, SIGUSR1 or SIGTERM, first. On exit code 3 it leaves a checkpoint in -output_dir, as
+# morphogen would (unless FAKE_CHECKPOINT=0).
+FAKE_LAUNCHER = r"""#!/bin/bash
+state=$FAKE_STATE
+n=$(( $(cat "$state/launch.count" 2>/dev/null || echo 0) + 1 ))
+echo "$n" > "$state/launch.count"
+printf '%s\n' "$@" > "$state/launch.args.$n"
+read -r -a codes <<< "${FAKE_EXIT_CODES:-0}"
+code=${codes[n-1]:-${codes[-1]}}
+out=""; prev=""
+for a in "$@"; do [[ $prev == -output_dir ]] && out=$a; prev=$a; done
+if [[ ${FAKE_WAIT_SIGNAL:-0} == 1 ]]; then
+  got=0
+  trap 'echo USR1 >> "$state/launch.signals"; got=$((got + 1))' USR1
+  trap 'echo TERM >> "$state/launch.signals"; got=$((got + 1))' TERM
+  echo $$ > "$state/launch.ready"
+  while ((got < ${FAKE_SIGNALS_NEEDED:-1})); do sleep 0.02; done
+fi
+if [[ $code == 3 && ${FAKE_CHECKPOINT:-1} == 1 && -n $out ]]; then
+  : > "$out/$(printf 'checkpoint_%07d.vtkhdf' $((n * 100)))"
+fi
+exit "$code"
+"""
+
+# Fake sbatch / qsub: records arguments, environment and working directory of each submission.
+FAKE_SUBMIT = r"""#!/bin/bash
+state=$FAKE_STATE
+n=$(( $(cat "$state/submit.count" 2>/dev/null || echo 0) + 1 ))
+echo "$n" > "$state/submit.count"
+printf '%s\n' "$@" > "$state/submit.args.$n"
+env -0 > "$state/submit.env.$n"
+pwd > "$state/submit.cwd.$n"
+if [[ ${FAKE_SUBMIT_RC:-0} != 0 ]]; then echo "submission refused" >&2; exit "$FAKE_SUBMIT_RC"; fi
+echo "Submitted batch job $((2000 + n))"
+"""
+
+FAKE_SQUEUE = r"""#!/bin/bash
+[[ -n ${FAKE_SQUEUE:-} ]] || { echo "squeue: error: no such job" >&2; exit 1; }
+echo "$FAKE_SQUEUE"
+"""
+
+FAKE_SCONTROL = r"""#!/bin/bash
+[[ -n ${FAKE_SCONTROL:-} ]] || exit 1
+printf 'JobId=%s JobName=morphogen\n   %s\n' "$3" "$FAKE_SCONTROL"
+"""
+
+FAKE_QSTAT = r"""#!/bin/bash
+[[ -n ${FAKE_QSTAT:-} ]] || exit 1
+printf 'Job Id: %s\n%s\n' "$2" "$FAKE_QSTAT"
+"""
+
+# Variables of a real job environment or of the caller that would change what the scripts do.
+SCRUB = ("SLURM_", "SBATCH_", "PBS_", "MORPHOGEN_", "FAKE_")
+SCRUB_NAMES = {"DECK", "OUT", "EXTRA_ARGS", "ENSEMBLE_FILE"}
+
+
+class Cluster:
+    """A temporary directory with the fake batch system on PATH and its records."""
+
+    def __init__(self, tmp):
+        self.tmp = tmp
+        self.bin = tmp / "bin"
+        self.state = tmp / "state"
+        self.bin.mkdir()
+        self.state.mkdir()
+        for name, text in (("srun", FAKE_LAUNCHER), ("mpiexec", FAKE_LAUNCHER), ("sbatch", FAKE_SUBMIT),
+                           ("qsub", FAKE_SUBMIT), ("squeue", FAKE_SQUEUE), ("scontrol", FAKE_SCONTROL),
+                           ("qstat", FAKE_QSTAT)):
+            path = self.bin / name
+            path.write_text(text)
+            path.chmod(0o755)
+        self.out = str(tmp / "out")
+
+    def env(self, **extra):
+        env = {k: v for k, v in os.environ.items() if not k.startswith(SCRUB) and k not in SCRUB_NAMES}
+        env["PATH"] = f"{self.bin}:{env.get('PATH', '/usr/bin:/bin')}"
+        env["FAKE_STATE"] = str(self.state)
+        env["MORPHOGEN"] = "/bin/true"  # the fake launchers do not run it
+        env.update({k: str(v) for k, v in extra.items()})
+        return env
+
+    def slurm_env(self, **extra):
+        base = dict(SLURM_JOB_ID="1000", SLURM_JOB_NAME="morphogen", SLURM_SUBMIT_DIR=str(self.tmp),
+                    SLURM_MEM_PER_CPU="2000", SLURM_CONF="/etc/slurm/slurm.conf", FAKE_SQUEUE="1:00:00",
+                    OUT=self.out)
+        base.update(extra)
+        return self.env(**base)
+
+    def pbs_env(self, **extra):
+        base = dict(PBS_JOBID="1000.pbs", PBS_JOBNAME="morphogen", PBS_O_WORKDIR=str(self.tmp),
+                    PBS_DEFAULT="pbs", FAKE_QSTAT="    Resource_List.walltime = 02:00:00\n"
+                    "    resources_used.walltime = 00:00:30", OUT=self.out)
+        base.update(extra)
+        return self.env(**base)
+
+    def run(self, script, env, args=(), timeout=30):
+        return subprocess.run(["bash", os.path.join(JOBS, script), *args], env=env, cwd=self.tmp,
+                              capture_output=True, text=True, timeout=timeout)
+
+    def start(self, script, env, args=()):
+        return subprocess.Popen(["bash", os.path.join(JOBS, script), *args], env=env, cwd=self.tmp,
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+    def count(self, what):
+        path = self.state / f"{what}.count"
+        return int(path.read_text()) if path.exists() else 0
+
+    def launch_args(self, n):
+        return (self.state / f"launch.args.{n}").read_text().splitlines()
+
+    def submit_args(self, n):
+        return (self.state / f"submit.args.{n}").read_text().splitlines()
+
+    def submit_env(self, n):
+        raw = (self.state / f"submit.env.{n}").read_bytes().split(b"\0")
+        return dict(item.decode().split("=", 1) for item in raw if b"=" in item)
+
+    def signals(self):
+        path = self.state / "launch.signals"
+        return path.read_text().split() if path.exists() else []
+
+    def follow(self, n, job_id):
+        """Run submission n as the batch system would: its script, arguments and environment."""
+        args, env = self.submit_args(n), self.submit_env(n)
+        i = next(i for i, a in enumerate(args) if a.endswith((".sbatch", ".pbs")))
+        script, script_args, opts = args[i], args[i + 1:], args[:i]
+        if script.endswith(".sbatch"):
+            env.update(SLURM_JOB_ID=str(job_id), SLURM_JOB_NAME="morphogen", SLURM_SUBMIT_DIR=str(self.tmp))
+            for o in opts:
+                if o.startswith("--array="):
+                    env["SLURM_ARRAY_TASK_ID"] = o.split("=", 1)[1]
+        else:
+            env.update(PBS_JOBID=f"{job_id}.pbs", PBS_O_WORKDIR=str(self.tmp))
+        return subprocess.run(["bash", script, *script_args], env=env, cwd=self.tmp, capture_output=True,
+                              text=True, timeout=60)
+
+    def history(self, out=None):
+        path = os.path.join(out or self.out, "morphogen_jobs.log")
+        return open(path).read() if os.path.exists(path) else ""
+
+
+@pytest.fixture
+def cluster(tmp_path):
+    return Cluster(tmp_path)
+
+
+def wait_for(path, proc, timeout=30):
+    """Poll for a file while the process runs."""
+    deadline = time.monotonic() + timeout
+    while not os.path.exists(path):
+        assert proc.poll() is None, f"exited early ({proc.returncode}): {proc.communicate()}"
+        assert time.monotonic() < deadline, f"timeout waiting for {path}"
+        time.sleep(0.02)
+
+
+# ---------------------------------------------------------------------------------------------
+# (a) shellcheck
+
+def test_all_scripts_present():
+    names = {os.path.basename(s) for s in SCRIPTS}
+    assert {"run.sbatch", "array.sbatch", "run.pbs", "array.pbs", "lib_morphogen.sh"} <= names
+
+
+@pytest.mark.parametrize("script", SCRIPTS, ids=os.path.basename)
+def test_shellcheck(script):
+    shellcheck = shutil.which("shellcheck")
+    if shellcheck is None:
+        pytest.skip("shellcheck is not installed")
+    res = subprocess.run([shellcheck, "-x", "-s", "bash", script], cwd=SOURCE, capture_output=True, text=True)
+    assert res.returncode == 0, res.stdout + res.stderr
+
+
+# ---------------------------------------------------------------------------------------------
+# Library functions
+
+def lib(snippet, **env):
+    res = subprocess.run(["bash", "-c", f'source "{JOBS}/lib_morphogen.sh"; {snippet}'], capture_output=True,
+                         text=True, timeout=10, env=dict(os.environ, **env))
+    return res.returncode, res.stdout.strip()
+
+
+@pytest.mark.parametrize("text,unit,seconds", [
+    ("59:58", 60, 3598), ("1:00:00", 60, 3600), ("  12:00:00 ", 60, 43200), ("2-03:04:05", 60, 183845),
+    ("1-0", 60, 86400), ("1-02:30", 60, 95400), ("30", 60, 1800), ("08:09", 60, 489),
+    ("3600", 1, 3600), ("01:00:00", 1, 3600), ("10:00", 1, 600), ("00:00:30", 1, 30),
+])
+def test_duration_seconds(text, unit, seconds):
+    assert lib(f'mg_duration_seconds "{text}" {unit}') == (0, str(seconds))
+
+
+@pytest.mark.parametrize("text", ["UNLIMITED", "NOT_SET", "INVALID", "", "1:2:3:4", "1-2:3:4:5", "abc", "-5"])
+def test_duration_seconds_rejects(text):
+    assert lib(f'mg_duration_seconds "{text}" 60')[0] != 0
+
+
+def test_split_and_quote_round_trip():
+    """EXTRA_ARGS and member lines are split like a shell would; the log quotes them back."""
+    words = ["-seed", "3", "-params_alpha", "12 +- 0.2% gauss", "it's", "a[1]", "", "-grid_n", "64,64"]
+    line = r"""-seed 3 -params_alpha "12 +- 0.2% gauss" it\'s a[1] '' -grid_n 64,64"""
+    rc, out = lib(r"""mg_split_words w "$LINE"; printf '%s\n' "${w[@]}"; """
+                  r"""eval "set -- $(mg_quote "${w[@]}")"; printf '%s\n' "$@" """, LINE=line)
+    assert rc == 0
+    assert out.split("\n") == words + words
+
+
+def test_latest_checkpoint(tmp_path):
+    for step in (900, 10000, 99999999, 20):
+        (tmp_path / f"checkpoint_{step:07d}.vtkhdf").write_text("")
+    (tmp_path / "checkpoint_latest.vtkhdf").write_text("")
+    assert lib(f'mg_latest_checkpoint "{tmp_path}"') == (0, "checkpoint_99999999.vtkhdf")
+    assert lib(f'mg_latest_checkpoint "{tmp_path}/none"') == (0, "")
+
+
+# ---------------------------------------------------------------------------------------------
+# (b) resubmission logic, SLURM
+
+def test_run_done_is_not_resubmitted(cluster):
+    env = cluster.slurm_env(DECK=DECK, EXTRA_ARGS="-steps 500 -png_every 0", FAKE_EXIT_CODES="0")
+    res = cluster.run("run.sbatch", env, ["-grid_n", "64,64"])
+    assert res.returncode == 0, res.stderr
+    assert cluster.launch_args(1) == ["/bin/true", DECK, "-output_dir", cluster.out, "-restart", "latest",
+                                      "-max_walltime", "56", "-steps", "500", "-png_every", "0",
+                                      "-grid_n", "64,64"]
+    assert cluster.count("submit") == 0
+    assert "run finished (exit 0)" in cluster.history()
+
+
+def test_exit_3_resubmits_with_same_arguments_and_environment(cluster):
+    args = ["input/turing_stripes.yaml", "-grid_n", "64,64", "-params_alpha", "12 +- 0.2% gauss"]
+    os.makedirs(cluster.tmp / "input")
+    shutil.copy(os.path.join(SOURCE, "input", "turing_stripes.yaml"), cluster.tmp / "input")
+    env = cluster.slurm_env(EXTRA_ARGS='-steps 500 -png_range_a "0,8"', FAKE_EXIT_CODES="3")
+    res = cluster.run("run.sbatch", env, args)
+    assert res.returncode == 0, res.stderr  # handed over to the resubmitted job
+    assert cluster.launch_args(1) == ["/bin/true", "input/turing_stripes.yaml", "-output_dir", cluster.out,
+                                      "-restart", "latest", "-max_walltime", "56", "-steps", "500",
+                                      "-png_range_a", "0,8", "-grid_n", "64,64", "-params_alpha",
+                                      "12 +- 0.2% gauss"]
+    assert cluster.count("submit") == 1
+    assert cluster.submit_args(1) == ["--export=ALL", "--job-name=morphogen",
+                                      os.path.join(JOBS, "run.sbatch"), *args]
+    sub = cluster.submit_env(1)
+    assert sub["MORPHOGEN_RESUBMIT_COUNT"] == "1"
+    assert sub["OUT"] == cluster.out and sub["EXTRA_ARGS"] == env["EXTRA_ARGS"]
+    assert sub["MORPHOGEN_JOB_SCRIPT"] == os.path.join(JOBS, "run.sbatch")
+    # this job's SLURM_* variables do not leak into the next job (SLURM_CONF does)
+    assert "SLURM_JOB_ID" not in sub and "SLURM_MEM_PER_CPU" not in sub
+    assert sub["SLURM_CONF"] == "/etc/slurm/slurm.conf"
+    assert (cluster.state / "submit.cwd.1").read_text().strip() == str(cluster.tmp)
+    assert "resubmitted (1 of at most 10)" in cluster.history()
+
+
+def test_chain_continues_until_done(cluster):
+    env = cluster.slurm_env(FAKE_EXIT_CODES="3 3 0")
+    assert cluster.run("run.sbatch", env, ["-steps", "900"]).returncode == 0
+    assert cluster.follow(1, 1001).returncode == 0
+    res = cluster.follow(2, 1002)
+    assert res.returncode == 0, res.stderr
+    assert cluster.count("launch") == 3 and cluster.count("submit") == 2
+    for n in (1, 2, 3):
+        assert cluster.launch_args(n)[1:5] == ["-output_dir", cluster.out, "-restart", "latest"]
+        assert cluster.launch_args(n)[-2:] == ["-steps", "900"]
+    assert cluster.submit_env(2)["MORPHOGEN_RESUBMIT_COUNT"] == "2"
+    log = cluster.history()
+    assert "segment 3 of at most 11 starts from checkpoint_0000200.vtkhdf" in log
+    assert log.count("resubmitted") == 2 and "run finished" in log
+
+
+def test_resubmission_cap(cluster):
+    env = cluster.slurm_env(FAKE_EXIT_CODES="3", MORPHOGEN_MAX_RESUBMIT="2")
+    assert cluster.run("run.sbatch", env).returncode == 0
+    assert cluster.follow(1, 1001).returncode == 0
+    res = cluster.follow(2, 1002)
+    assert res.returncode == 3  # stopped at a checkpoint, not resubmitted
+    assert cluster.count("launch") == 3 and cluster.count("submit") == 2
+    assert "resubmission cap reached (2 of MORPHOGEN_MAX_RESUBMIT=2)" in res.stderr
+    assert "not resubmitted" in cluster.history()
+
+
+def test_cap_zero_never_resubmits(cluster):
+    res = cluster.run("run.sbatch", cluster.slurm_env(FAKE_EXIT_CODES="3", MORPHOGEN_MAX_RESUBMIT="0"))
+    assert res.returncode == 3 and cluster.count("submit") == 0
+
+
+def test_no_new_checkpoint_is_not_resubmitted(cluster):
+    env = cluster.slurm_env(FAKE_EXIT_CODES="3", FAKE_CHECKPOINT="0")
+    res = cluster.run("run.sbatch", env)
+    assert res.returncode == 3 and cluster.count("submit") == 0
+    assert "no new checkpoint" in res.stderr
+    env["MORPHOGEN_REQUIRE_PROGRESS"] = "0"
+    assert cluster.run("run.sbatch", env).returncode == 0
+    assert cluster.count("submit") == 1
+
+
+def test_failed_submission_exits_3(cluster):
+    res = cluster.run("run.sbatch", cluster.slurm_env(FAKE_EXIT_CODES="3", FAKE_SUBMIT_RC="1"))
+    assert res.returncode == 3
+    assert "resubmission failed" in res.stderr
+
+
+@pytest.mark.parametrize("code", [1, 2, 4, 137])
+def test_failures_are_not_resubmitted(cluster, code):
+    res = cluster.run("run.sbatch", cluster.slurm_env(FAKE_EXIT_CODES=str(code)))
+    assert res.returncode == code
+    assert cluster.count("submit") == 0
+    assert f"run failed (exit {code}" in cluster.history()
+
+
+def test_bad_configuration(cluster):
+    res = cluster.run("run.sbatch", cluster.slurm_env(DECK="missing.yaml"))
+    assert res.returncode == 1 and "DECK=missing.yaml" in res.stderr
+    res = cluster.run("run.sbatch", cluster.slurm_env(MORPHOGEN="/nonexistent/morphogen"))
+    assert res.returncode == 1 and "no such executable" in res.stderr
+    res = cluster.run("run.sbatch", cluster.slurm_env(EXTRA_ARGS='-params_alpha "12'))
+    assert res.returncode == 1 and "unbalanced quotes" in res.stderr
+    res = cluster.run("run.sbatch", cluster.slurm_env(MORPHOGEN_MAX_WALLTIME="soon"))
+    assert res.returncode == 1 and "MORPHOGEN_MAX_WALLTIME" in res.stderr
+    assert cluster.count("launch") == 0
+
+
+def test_output_dir_from_options(cluster):
+    env = cluster.slurm_env(FAKE_EXIT_CODES="0")
+    del env["OUT"]
+    assert cluster.run("run.sbatch", env, ["-output_dir", "mine", "-steps", "5"]).returncode == 0
+    assert cluster.launch_args(1)[1:3] == ["-output_dir", "mine"]
+    assert os.path.exists(cluster.tmp / "mine" / "morphogen_jobs.log")
+
+
+@pytest.mark.parametrize("extra,expected", [
+    (dict(FAKE_SQUEUE="", FAKE_SCONTROL="RunTime=00:10:00 TimeLimit=02:00:00"), ["-max_walltime", "106"]),
+    (dict(FAKE_SQUEUE="1-00:00:00"), ["-max_walltime", "1436"]),
+    (dict(FAKE_SQUEUE="UNLIMITED"), []),
+    (dict(FAKE_SQUEUE="", FAKE_SCONTROL="RunTime=00:10:00 TimeLimit=UNLIMITED"), []),
+    (dict(FAKE_SQUEUE="", FAKE_SCONTROL=""), []),
+    (dict(FAKE_SQUEUE="4:59"), []),  # shorter than the margin
+    (dict(MORPHOGEN_WALLTIME_MARGIN="600"), ["-max_walltime", "50"]),
+    (dict(MORPHOGEN_MAX_WALLTIME="off"), []),
+    (dict(MORPHOGEN_MAX_WALLTIME="30"), ["-max_walltime", "30"]),
+    (dict(EXTRA_ARGS="-max_walltime 7"), ["-max_walltime", "7"]),  # the user's own, not ours
+])
+def test_max_walltime(cluster, extra, expected):
+    res = cluster.run("run.sbatch", cluster.slurm_env(FAKE_EXIT_CODES="0", **extra))
+    assert res.returncode == 0, res.stderr
+    args = cluster.launch_args(1)
+    got = [] if "-max_walltime" not in args else args[args.index("-max_walltime"):][:2]
+    assert got == expected
+    assert args.count("-max_walltime") <= 1
+
+
+# ---------------------------------------------------------------------------------------------
+# (c) signals: the batch shell forwards them to the run and acts on its exit code
+
+@pytest.mark.parametrize("sig,code,resubmit_on_term,rc,submits", [
+    (signal.SIGUSR1, 3, "0", 0, 1),  # --signal=B:USR1@...: checkpoint, resubmit
+    (signal.SIGUSR1, 0, "0", 0, 0),  # the run finished anyway
+    (signal.SIGUSR1, 1, "0", 1, 0),  # the run failed
+    (signal.SIGTERM, 3, "0", 3, 0),  # scancel: checkpoint, end of the chain
+    (signal.SIGTERM, 3, "1", 0, 1),  # preemption with MORPHOGEN_RESUBMIT_ON_TERM=1
+])
+def test_signal_forwarded(cluster, sig, code, resubmit_on_term, rc, submits):
+    env = cluster.slurm_env(FAKE_EXIT_CODES=str(code), FAKE_WAIT_SIGNAL="1",
+                            MORPHOGEN_RESUBMIT_ON_TERM=resubmit_on_term)
+    proc = cluster.start("run.sbatch", env, ["-steps", "100"])
+    rc_got, err = send_signal_when_ready(cluster, proc, sig)
+    # srun gets SIGUSR1 whatever arrived: srun answers SIGTERM by killing the step
+    assert cluster.signals() == ["USR1"], err
+    assert rc_got == rc, err
+    assert cluster.count("submit") == submits
+    if submits:
+        assert cluster.submit_args(1)[-3:] == [os.path.join(JOBS, "run.sbatch"), "-steps", "100"]
+
+
+@pytest.mark.parametrize("sig,rc,submits", [(signal.SIGUSR1, 0, 1), (signal.SIGTERM, 3, 0)])
+def test_signal_forwarded_pbs(cluster, sig, rc, submits):
+    """qsig -s USR1 / qdel on PBS: the same forwarding, to mpiexec."""
+    env = cluster.pbs_env(FAKE_EXIT_CODES="3", FAKE_WAIT_SIGNAL="1", PBS_ARRAY_INDEX="4")
+    proc = cluster.start("array.pbs", env)
+    rc_got, err = send_signal_when_ready(cluster, proc, sig)
+    assert cluster.signals() == ["USR1"], err
+    assert rc_got == rc, err
+    assert cluster.count("submit") == submits
+
+
+def send_signal_when_ready(cluster, proc, sig):
+    """Send a signal to the batch shell once its run is up; returns (exit code, stderr)."""
+    try:
+        wait_for(cluster.state / "launch.ready", proc)
+        proc.send_signal(sig)
+        _, err = proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    return proc.returncode, err
+
+
+def test_repeated_signals_wait_for_the_real_exit_code(cluster):
+    """Each signal interrupts `wait`; the script must keep waiting for the run's own exit."""
+    env = cluster.slurm_env(FAKE_EXIT_CODES="3", FAKE_WAIT_SIGNAL="1", FAKE_SIGNALS_NEEDED="3")
+    proc = cluster.start("run.sbatch", env)
+    try:
+        wait_for(cluster.state / "launch.ready", proc)
+        for k in range(1, 4):
+            proc.send_signal(signal.SIGUSR1)
+            deadline = time.monotonic() + 20
+            while len(cluster.signals()) < k:
+                assert time.monotonic() < deadline
+                time.sleep(0.02)
+            if k < 3:
+                assert proc.poll() is None
+        _, err = proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert cluster.signals() == ["USR1"] * 3
+    assert proc.returncode == 0, err
+    assert cluster.count("submit") == 1
+
+
+# ---------------------------------------------------------------------------------------------
+# Arrays and PBS
+
+def test_array_sbatch_member_from_ensemble_file(cluster):
+    env = cluster.slurm_env(SLURM_ARRAY_TASK_ID="3", ENSEMBLE_FILE=os.path.join(JOBS, "ensemble_example.txt"),
+                            FAKE_EXIT_CODES="3 0")
+    res = cluster.run("array.sbatch", env, [DECK])
+    assert res.returncode == 0, res.stderr
+    member_out = os.path.join(cluster.out, "member_0003")
+    args = cluster.launch_args(1)
+    assert args[:6] == ["/bin/true", DECK, "-output_dir", member_out, "-restart", "latest"]
+    assert args[-4:] == ["-seed", "3", "-params_alpha", "12 +- 0.2% gauss"]
+    # only this index is resubmitted
+    assert cluster.submit_args(1) == ["--export=ALL", "--job-name=morphogen", "--array=3",
+                                      os.path.join(JOBS, "array.sbatch"), DECK]
+    assert cluster.follow(1, 1001).returncode == 0
+    assert cluster.launch_args(2) == args
+    assert cluster.count("submit") == 1
+    assert "resubmitted" in cluster.history(member_out) and "finished" in cluster.history(member_out)
+
+
+def test_array_sbatch_seed_members(cluster):
+    env = cluster.slurm_env(SLURM_ARRAY_TASK_ID="7", FAKE_EXIT_CODES="0")
+    assert cluster.run("array.sbatch", env).returncode == 0
+    args = cluster.launch_args(1)
+    assert args[1:3] == ["-output_dir", os.path.join(cluster.out, "member_0007")]
+    assert args[-2:] == ["-seed", "7"]
+
+
+def test_array_index_out_of_range(cluster):
+    env = cluster.slurm_env(SLURM_ARRAY_TASK_ID="5", ENSEMBLE_FILE=os.path.join(JOBS, "ensemble_example.txt"))
+    res = cluster.run("array.sbatch", env)
+    assert res.returncode == 1 and "has 4 member lines" in res.stderr
+    res = cluster.run("array.sbatch", cluster.slurm_env())
+    assert res.returncode == 1 and "not an array task" in res.stderr
+    assert cluster.count("launch") == 0
+
+
+def test_run_pbs(cluster):
+    env = cluster.pbs_env(DECK=DECK, EXTRA_ARGS="-steps 500", FAKE_EXIT_CODES="3 0")
+    res = cluster.run("run.pbs", env)
+    assert res.returncode == 0, res.stderr
+    # walltime 2 h, 30 s used, 240 s margin
+    assert cluster.launch_args(1) == ["/bin/true", DECK, "-output_dir", cluster.out, "-restart", "latest",
+                                      "-max_walltime", "115", "-steps", "500"]
+    assert cluster.submit_args(1) == ["-V", "-N", "morphogen", os.path.join(JOBS, "run.pbs")]
+    sub = cluster.submit_env(1)
+    assert sub["MORPHOGEN_RESUBMIT_COUNT"] == "1" and sub["DECK"] == DECK
+    assert "PBS_JOBID" not in sub and sub["PBS_DEFAULT"] == "pbs"
+    assert cluster.follow(1, 1001).returncode == 0
+    assert cluster.count("launch") == 2 and cluster.count("submit") == 1
+
+
+def test_run_pbs_torque_walltime_and_no_arguments(cluster):
+    env = cluster.pbs_env(FAKE_QSTAT="", PBS_WALLTIME="3600", FAKE_EXIT_CODES="0")
+    assert cluster.run("run.pbs", env).returncode == 0
+    assert cluster.launch_args(1)[-2:] == ["-max_walltime", "56"]
+    res = cluster.run("run.pbs", env, ["-steps", "5"])
+    assert res.returncode == 1 and "no arguments" in res.stderr
+
+
+def test_array_pbs_member_resubmitted_as_single_job(cluster):
+    env = cluster.pbs_env(PBS_ARRAY_INDEX="2", ENSEMBLE_FILE=os.path.join(JOBS, "ensemble_example.txt"),
+                          FAKE_EXIT_CODES="3 3 0")
+    assert cluster.run("array.pbs", env).returncode == 0
+    member_out = os.path.join(cluster.out, "member_0002")
+    assert cluster.launch_args(1)[1:3] == ["-output_dir", member_out]
+    assert cluster.launch_args(1)[-2:] == ["-seed", "2"]
+    assert cluster.submit_args(1) == ["-V", "-N", "morphogen", os.path.join(JOBS, "array.pbs")]
+    sub = cluster.submit_env(1)
+    assert sub["MORPHOGEN_ARRAY_INDEX"] == "2" and "PBS_ARRAY_INDEX" not in sub
+    assert cluster.follow(1, 1001).returncode == 0
+    assert cluster.follow(2, 1002).returncode == 0
+    assert [cluster.launch_args(n) for n in (2, 3)] == [cluster.launch_args(1)] * 2
+    assert cluster.count("submit") == 2
+
+
+# ---------------------------------------------------------------------------------------------
+# The real binary: SIGUSR1 -> checkpoint, exit 3 -> resubmission -> restart -> done
+
+def test_real_morphogen_signal_checkpoint_restart(cluster):
+    out = cluster.out
+    steps = 60000
+    env = cluster.slurm_env(
+        MORPHOGEN=EXE, MORPHOGEN_LAUNCHER=f"{MPIEXEC} --oversubscribe -n 2",
+        EXTRA_ARGS=f"-grid_n 16,16 -steps {steps} -checkpoint_every 1000 -png_every 0",
+        OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_rmaps_base_oversubscribe="1")
+    proc = cluster.start("run.sbatch", env)
+    try:
+        deadline = time.monotonic() + 60
+        while not glob.glob(os.path.join(out, "checkpoint_*.vtkhdf")):
+            if proc.poll() is not None:
+                pytest.fail(f"run ended before its first checkpoint ({proc.returncode}): {proc.communicate()}")
+            assert time.monotonic() < deadline, "no checkpoint within 60 s"
+            time.sleep(0.05)
+        proc.send_signal(signal.SIGUSR1)
+        stdout, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 0, stdout + err  # exit 3, resubmitted
+    assert cluster.count("submit") == 1
+    first = sorted(glob.glob(os.path.join(out, "checkpoint_*.vtkhdf")))[-1]
+    assert not os.path.exists(os.path.join(out, "a_final.png"))
+    res = cluster.follow(1, 1001)  # the resubmitted job restarts from the checkpoint
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert cluster.count("submit") == 1
+    assert os.path.exists(os.path.join(out, "a_final.png"))
+    log = cluster.history()
+    assert f"starts from {os.path.basename(first)}" in log and "run finished (exit 0)" in log
