@@ -14,10 +14,11 @@
 // L = n h. Modes are binned into rings of width dk = 2 pi / max(Lx, Ly) (ring b holds
 // |k| in [(b - 1/2) dk, (b + 1/2) dk)) up to the Nyquist wavenumber of the coarser axis;
 // S(b) = mean power of the modes in ring b (the radially averaged power spectrum). The peak ring
-// b* maximises S over b >= 1; k_peak = sum_{|b - b*| <= 1, b >= 1} S(b) kbar(b) / sum S(b),
-// where kbar(b) is the power-weighted mean |k| of ring b (postproc/wavelength.py's estimate,
-// with exact ring radii). wavelength = 2 pi / k_peak; wavelength_cells = wavelength /
-// sqrt(hx hy).
+// b* maximises S over b >= 1. k_peak: the centroid C(B) = sum_B S(b) kbar(b) / sum_B S(b),
+// kbar(b) the power-weighted mean |k| of ring b, first over the rings |b - b*| <= 1
+// (postproc/wavelength.py's estimate, with exact ring radii), then twice over the rings with
+// b dk in [k_peak / 1.25, 1.25 k_peak] about the previous value (steadier for broad, noisy
+// peaks). wavelength = 2 pi / k_peak; wavelength_cells = wavelength / sqrt(hx hy).
 //   peak_power_fraction: power with |k| in [k_peak / 1.25, 1.25 k_peak] over all power (DC
 //     excluded): near 1 for a single sinusoidal pattern, small for broadband noise.
 //   peak_sharpness: k_peak / FWHM of S around b* (half-maximum crossings interpolated
@@ -47,8 +48,11 @@
 // (1 for a solid ellipse, small for rings and branched shapes). Wrapping components have
 // elongation = +inf and fill = 0.
 //   speck: a component of at most kSpeckMaxCells cells (ignored in the fractions below).
-//   spot: a non-wrapping, non-speck component with elongation <= kSpotMaxElongation and
-//     fill >= kSpotMinFill. Spots of the low phase are holes.
+//   spot: a non-wrapping, non-speck component with elongation <= kSpotMaxElongation,
+//     fill >= kSpotMinFill and area <= kSpotMaxAreaWavelengths * wavelength^2 (a spot fits in
+//     the unit cell of its pattern; this keeps a closed box's connected background, compact
+//     but riddled with holes, from counting as one big spot). Spots of the low phase are
+//     holes.
 //   elongated: every other non-speck component (wrapping, elongated, ring-like or branched).
 //
 // Euler characteristic of the high phase (4-connected) as a subset of the torus (or of the
@@ -70,6 +74,8 @@ inline constexpr long kSpeckMaxCells = 2;
 inline constexpr double kSpotMaxElongation = 2.0;
 // ... and at least this fill of its moment ellipse (rings and branched shapes fall below).
 inline constexpr double kSpotMinFill = 0.6;
+// ... and at most this many squared wavelengths in area (a hexagonal unit cell is 1.15).
+inline constexpr double kSpotMaxAreaWavelengths = 2.0;
 
 struct FieldShape2D {
   int nx = 0, ny = 0;    // cells per axis
@@ -79,11 +85,11 @@ struct FieldShape2D {
 
 // One connected component of a phase.
 struct Component {
-  long area = 0;          // cells
-  double cx = 0, cy = 0;  // centroid, physical units, in [0, L) on periodic axes
-  double elongation = 1;  // sqrt(l1 / l2); +inf when wrapping
-  double fill = 1;        // area / (4 pi sqrt(l1 l2)); 0 when wrapping
-  int winding_rank = 0;   // 0: contractible; 1: winds in one direction; 2: in two
+  long area = 0;         // cells
+  double cx = 0, cy = 0; // centroid, physical units, in [0, L) on periodic axes
+  double elongation = 1; // sqrt(l1 / l2); +inf when wrapping
+  double fill = 1;       // area / (4 pi sqrt(l1 l2)); 0 when wrapping
+  int winding_rank = 0;  // 0: contractible; 1: winds in one direction; 2: in two
   bool speck = false, spot = false;
 };
 
@@ -136,9 +142,11 @@ struct PatternMetrics {
 PatternMetrics compute_pattern_metrics(const double* u, const FieldShape2D& shape);
 
 // Connected components of mask (nx*ny bytes, nonzero = member), connectivity 4 or 8, wrapping
-// across periodic axes; spot/speck flags set by the rules above. Exposed for tests and tools.
-std::vector<Component> label_components(const unsigned char* mask, const FieldShape2D& shape,
-                                        int connectivity);
+// across periodic axes; spot/speck flags set by the rules above, with max_spot_area (physical
+// units) in place of kSpotMaxAreaWavelengths * wavelength^2. Exposed for tests and tools.
+std::vector<Component>
+label_components(const unsigned char* mask, const FieldShape2D& shape, int connectivity,
+                 double max_spot_area = std::numeric_limits<double>::infinity());
 
 // Euler characteristic of the 4-connected set mask (see above).
 long euler_characteristic_4(const unsigned char* mask, const FieldShape2D& shape);
