@@ -71,7 +71,8 @@ void FieldSampler::take(Simulation& sim) {
   }
   const Box& ob = g.owned();
   const auto& n = g.spec().n;
-  const PetscInt ci = n[0] / 2, cj = n[1] / 2, ck = g.dim() == 3 ? n[2] / 2 : 0;
+  // The probe sits off-centre: a spiral started at the centre rotates about it.
+  const PetscInt ci = n[0] / 3, cj = n[1] / 3, ck = g.dim() == 3 ? n[2] / 3 : 0;
   // Per species: sum, sum of squares, sum of squared change, probe.
   std::vector<double> acc(4 * ns, 0.0);
   const bool first = prev_[0].empty();
@@ -104,7 +105,7 @@ void FieldSampler::take(Simulation& sim) {
     r.t.push_back(sim.time());
     r.mean.push_back(mean);
     r.stddev.push_back(std::sqrt(std::max(0.0, a4[1] / cells - mean * mean)));
-    r.change.push_back(first ? std::nan("") : std::sqrt(a4[2]) / (std::sqrt(a4[1]) + 1e-300));
+    r.change.push_back(first ? std::nan("") : std::sqrt(a4[2] / cells)); // RMS change per cell
     r.probe.push_back(a4[3]);
   }
 }

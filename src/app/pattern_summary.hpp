@@ -1,7 +1,7 @@
 // What a run's pattern is, for summary.json and for sweep records:
 //  - FieldSampler: cheap metrics of every species sampled during the run (spatial mean and
-//    standard deviation, L2 change relative to the field since the previous sample, the value
-//    at the centre cell), one allreduce per sample;
+//    standard deviation, RMS change per cell since the previous sample, the value at the cell
+//    (nx/3, ny/3, nz/3)), one allreduce per sample;
 //  - classify_species: the final field of one species (2-D, or the middle z slice in 3-D)
 //    gathered to rank 0, its pattern metrics (analysis/pattern_metrics.hpp), the run's dynamics
 //    from the samples (analysis/time_series.hpp) and the class (analysis/classify.hpp);

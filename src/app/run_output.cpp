@@ -72,7 +72,7 @@ void RunOutput::begin(Simulation& sim, long long restart_step, PetscInt end_step
     next_checkpoint_time_ = next_multiple(sim.time(), out.checkpoint_every_time);
   last_step_wall_ = MPI_Wtime();
   sampler_ = FieldSampler();
-  sample_every_ = std::max<PetscInt>(1, (end_step - sim.step_index()) / 100);
+  sample_every_ = std::max<PetscInt>(1, (end_step - sim.step_index()) / 1000);
   if (out.summary) sampler_.take(sim);
   const bool periodic = out.snapshot_every > 0 || out.snapshot_every_time > 0;
   if (restart_step < 0 && sim.level() == 0 && periodic) write_snapshot(sim);

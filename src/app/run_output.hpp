@@ -33,7 +33,7 @@ public:
   // After every step. Returns true when the run must stop (a checkpoint has been written).
   bool after_step(Simulation& sim);
   // Final snapshot and checkpoint of the last level, and summary.json: per species the pattern
-  // class and metrics (with the run's dynamics from samples taken every 1/100 of the run),
+  // class and metrics (with the run's dynamics from samples taken every 1/1000 of the run),
   // and the linear stability of the parameters.
   void finish(Simulation& sim);
 

@@ -21,7 +21,7 @@ struct SweepSettings {
   std::string dir;                // sweep output directory (-output_dir)
   std::string base_dir;           // deck directory (relative file names in values)
   std::string species;            // species the metrics are computed on ("" = the first)
-  long long samples = 100;        // time-series samples per run
+  long long samples = 1000;       // time-series samples per run
   std::vector<std::string> known; // sweep_* options (not unused for the point's Options)
 };
 

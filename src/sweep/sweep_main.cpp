@@ -28,6 +28,7 @@ struct Setup {
   SweepSettings set;
   int group_size = 1;
   long long chunk = 0, chunks = 1;
+  double max_walltime = 0; // minutes
 };
 
 Setup read_setup(Options& opt, const std::string& base_dir) {
@@ -69,11 +70,20 @@ Setup read_setup(Options& opt, const std::string& base_dir) {
   s.set.species = opt.string("sweep_species", "",
                              "species the metrics and class are computed on (default: the "
                              "model's first)");
-  s.set.samples = opt.integer("sweep_samples", 100, 4, 100000,
+  s.set.samples = opt.integer("sweep_samples", 1000, 4, 1000000,
                               "time-series samples per point (for steady / periodic / chaotic)");
+  s.max_walltime = opt.real("max_walltime", 0, 0, Options::inf,
+                            "wall-time budget in minutes: no point starts that might not finish "
+                            "within it (unfinished points: exit code 3; rerun to continue)");
+  const std::string restart = opt.string("restart", "latest",
+                                         "sweeps always resume (finished points are skipped): "
+                                         "only 'latest' is accepted");
+  if (restart != "latest")
+    throw UserError("-restart " + restart +
+                    ": a sweep always resumes from its finished points; allowed: latest");
   s.set.base_dir = base_dir;
   for (const char* k : {"sweep_axes", "sweep_group_size", "sweep_chunks", "sweep_chunk",
-                        "sweep_species", "sweep_samples"})
+                        "sweep_species", "sweep_samples", "max_walltime", "restart"})
     s.set.known.emplace_back(k);
   return s;
 }
@@ -126,6 +136,7 @@ std::vector<long long> finished_points(const std::string& dir, long long n) {
 } // namespace
 
 int run_sweep(int* argc, char*** argv) {
+  const double wall_start = MPI_Wtime();
   MPI_Comm world = PETSC_COMM_WORLD;
   int rank = 0;
   MPI_Comm_rank(world, &rank);
@@ -180,11 +191,15 @@ int run_sweep(int* argc, char*** argv) {
 
   WorkQueue q(world, s.group_size, todo);
   const double t0 = MPI_Wtime();
+  if (s.max_walltime > 0) q.set_deadline(wall_start + s.max_walltime * 60.0);
   double cell_updates = 0;
   long long ran = 0;
   bool interrupted = false;
-  for (long long p = q.next(); p >= 0; p = q.next()) {
+  double last_seconds = 0;
+  for (long long p = q.next(); p >= 0; p = q.next(last_seconds)) {
+    const double tp = MPI_Wtime();
     const nlohmann::json r = run_point(s.spec, p, s.set, q, interrupted);
+    last_seconds = MPI_Wtime() - tp;
     if (interrupted) {
       // Stop handing out points; wait for the others to finish theirs.
       while (q.next() >= 0) {
@@ -218,6 +233,8 @@ int run_sweep(int* argc, char*** argv) {
   MPI_Allreduce(MPI_IN_PLACE, totals, 2, MPI_DOUBLE, MPI_SUM, world);
   int any_interrupted = interrupted;
   MPI_Allreduce(MPI_IN_PLACE, &any_interrupted, 1, MPI_INT, MPI_LOR, world);
+  int cut = q.cut_by_deadline();
+  MPI_Bcast(&cut, 1, MPI_INT, 0, world);
   if (rank == 0) {
     const std::string terr = write_sweep_table(dir, s.spec, yaml);
     if (!terr.empty()) {
@@ -230,9 +247,11 @@ int run_sweep(int* argc, char*** argv) {
                 wall > 0 ? totals[0] / wall : 0.0, dir.c_str());
     std::fflush(stdout);
   }
-  if (any_interrupted) {
-    PetscPrintf(world, "sweep: stopped by a signal; run the same command again to finish the "
-                       "remaining points (exit code 3)\n");
+  if (any_interrupted || cut) {
+    PetscPrintf(world,
+                "sweep: stopped by %s; run the same command again to finish the remaining "
+                "points (exit code 3)\n",
+                any_interrupted ? "a signal" : "the -max_walltime budget");
     return 3;
   }
   return 0;

@@ -2,6 +2,8 @@
 
 #include "core/user_error.hpp"
 
+#include <algorithm>
+
 namespace morphogen::sweep {
 
 namespace {
@@ -26,19 +28,23 @@ WorkQueue::~WorkQueue() {
   if (group_ != MPI_COMM_NULL) MPI_Comm_free(&group_);
 }
 
-long long WorkQueue::take() {
+long long WorkQueue::take(double seconds) {
+  longest_ = std::max(longest_, seconds);
+  if (cursor_ < todo_.size() && deadline_ > 0 && MPI_Wtime() + 1.5 * longest_ > deadline_) {
+    cut_ = true;
+    cursor_ = todo_.size();
+  }
   return cursor_ < todo_.size() ? todo_[cursor_++] : -1;
 }
 
-long long WorkQueue::next() {
+long long WorkQueue::next(double last_seconds) {
   long long p = -1;
   if (group_rank_ == 0) {
     if (world_rank_ == 0) {
       poll();
-      p = take();
+      p = take(last_seconds);
     } else {
-      int dummy = 0;
-      MPI_Send(&dummy, 1, MPI_INT, 0, kTagRequest, world_);
+      MPI_Send(&last_seconds, 1, MPI_DOUBLE, 0, kTagRequest, world_);
       MPI_Recv(&p, 1, MPI_LONG_LONG, 0, kTagAssign, world_, MPI_STATUS_IGNORE);
     }
   }
@@ -53,9 +59,9 @@ void WorkQueue::poll() {
     MPI_Status st;
     MPI_Iprobe(MPI_ANY_SOURCE, kTagRequest, world_, &flag, &st);
     if (!flag) return;
-    int dummy = 0;
-    MPI_Recv(&dummy, 1, MPI_INT, st.MPI_SOURCE, kTagRequest, world_, MPI_STATUS_IGNORE);
-    const long long p = take();
+    double seconds = 0;
+    MPI_Recv(&seconds, 1, MPI_DOUBLE, st.MPI_SOURCE, kTagRequest, world_, MPI_STATUS_IGNORE);
+    const long long p = take(seconds);
     if (p < 0) ++stopped_leaders_;
     MPI_Send(&p, 1, MPI_LONG_LONG, st.MPI_SOURCE, kTagAssign, world_);
   }
@@ -65,9 +71,9 @@ void WorkQueue::drain() {
   if (world_rank_ == 0) {
     while (stopped_leaders_ < ngroups_ - 1) {
       MPI_Status st;
-      int dummy = 0;
-      MPI_Recv(&dummy, 1, MPI_INT, MPI_ANY_SOURCE, kTagRequest, world_, &st);
-      const long long p = take();
+      double seconds = 0;
+      MPI_Recv(&seconds, 1, MPI_DOUBLE, MPI_ANY_SOURCE, kTagRequest, world_, &st);
+      const long long p = take(seconds);
       if (p < 0) ++stopped_leaders_;
       MPI_Send(&p, 1, MPI_LONG_LONG, st.MPI_SOURCE, kTagAssign, world_);
     }
