@@ -1,4 +1,4 @@
-// Pattern classification rules (documented in classify.hpp and CLASSES.md).
+// Pattern classification rules (documented in classify.hpp and README.md).
 #include "analysis/classify.hpp"
 
 #include <algorithm>

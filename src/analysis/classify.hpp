@@ -4,7 +4,7 @@
 //
 // Classes, with the names written to CSV / JSON: "uniform", "spots", "holes", "stripes",
 // "labyrinth", "mixed", "oscillating", "chaotic", "blowup". The rules, applied in this order
-// (the first that holds gives the class; the same text is in CLASSES.md):
+// (the first that holds gives the class; the same text is in README.md, "Pattern classes"):
 //
 //  1. blowup       the final field has a NaN or infinite value, or max |u| > bound (default
 //                  kBlowupBound = 1e10), or a sampled channel has a NaN or infinite value.
