@@ -87,6 +87,8 @@ int run(int* argc, char*** argv) {
   MPI_Comm comm = PETSC_COMM_WORLD;
   const std::string base_dir = load_deck(argc, argv);
   Options opt(comm);
+  if (opt.is_set("sweep_axes"))
+    throw UserError("-sweep_axes: this deck is a sweep; run it with morphogen sweep DECK.yaml");
   if (opt.help_requested())
     PetscPrintf(comm, "morphogen %s options (-name <current value>: help):\n", MORPHOGEN_VERSION);
   // Coarse-to-fine grid sequencing (Witkin-Kass 5.2, Lawlor): levels 1..L-1 run on grids

@@ -17,6 +17,18 @@ from conftest import SOURCE, run
 DECKS = sorted(glob.glob(os.path.join(SOURCE, "input", "*.yaml")))
 IDS = [os.path.splitext(os.path.basename(d))[0] for d in DECKS]
 
+
+def is_sweep(path):
+    with open(path) as f:
+        return "sweep" in yaml.safe_load(f)
+
+
+# Single-run decks, and sweep decks (a `sweep:` section, run with `morphogen sweep`).
+RUNS = [d for d in DECKS if not is_sweep(d)]
+RUN_IDS = [os.path.splitext(os.path.basename(d))[0] for d in RUNS]
+SWEEPS = [d for d in DECKS if is_sweep(d)]
+SWEEP_IDS = [os.path.splitext(os.path.basename(d))[0] for d in SWEEPS]
+
 # Papers and authors a deck header may cite (the papers in shared/papers, their models' authors).
 SOURCES = re.compile(
     r"Sanderson|Garrity|Pearson|Lawlor|Witkin|Kass|Turk|Turing|Gray-Scott|Sims|Barkley|"
@@ -77,11 +89,14 @@ def test_deck_header_and_conventions(deck):
     with open(deck) as f:
         cfg = yaml.safe_load(f)
     assert str(cfg.get("output_dir")) == name, f"{name}: output_dir should be the deck name"
+    if "sweep" in cfg:
+        assert f"morphogen sweep input/{name}.yaml" in text, f"{name}: say how to run the sweep"
+        return
     steps, every = int(cfg["steps"]), int(cfg["png_every"])
     assert 4 <= steps // every <= 6, f"{name}: {steps} steps / png_every {every} images"
 
 
-@pytest.mark.parametrize("deck", DECKS, ids=IDS)
+@pytest.mark.parametrize("deck", RUNS, ids=RUN_IDS)
 def test_deck_runs(deck, workdir, model_species):
     out = workdir / "out"
     t0 = time.time()
@@ -104,7 +119,7 @@ def test_deck_runs(deck, workdir, model_species):
             assert png.is_file() and png.stat().st_size > 0, f"missing {png.name}"
 
 
-@pytest.mark.parametrize("deck", DECKS, ids=IDS)
+@pytest.mark.parametrize("deck", RUNS, ids=RUN_IDS)
 def test_options_used_is_a_deck(deck, workdir):
     first, second = workdir / "first", workdir / "second"
     proc = run([deck, "-steps", "2", "-output_dir", str(first)], cwd=workdir, timeout=120)
@@ -122,3 +137,25 @@ def test_options_used_is_a_deck(deck, workdir):
     for name in finals:
         assert (first / name).read_bytes() == (second / name).read_bytes(), \
             f"{name} differs when rerun from options_used.yaml"
+
+
+@pytest.mark.parametrize("deck", SWEEPS, ids=SWEEP_IDS)
+def test_sweep_deck_runs(deck, workdir):
+    """A sweep deck runs every point (20 steps each, 2 ranks), and the options_used.yaml it
+    writes reruns as the same sweep; as a plain run it is refused with a pointer to `sweep`."""
+    import json
+    first, second = workdir / "first", workdir / "second"
+    proc = run(["sweep", deck, "-steps", "20", "-output_dir", str(first)], workdir, 2, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    with open(first / "sweep.json") as f:
+        a = json.load(f)
+    npoints = int(re.search(r"sweep: (\d+) points", proc.stdout).group(1))
+    assert a["finished"] == a["points"] == npoints > 1
+    proc = run(["sweep", str(first / "options_used.yaml"), "-steps", "20", "-output_dir",
+                str(second)], workdir, 2, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    with open(second / "sweep.json") as f:
+        b = json.load(f)
+    assert [r["class"] for r in a["records"]] == [r["class"] for r in b["records"]]
+    proc = run([deck, "-steps", "2", "-output_dir", "plain"], workdir)
+    assert proc.returncode == 1 and "morphogen sweep" in proc.stderr, proc.stderr
