@@ -1,17 +1,18 @@
 # shellcheck shell=bash
-# Shared logic of the morphogen job scripts (run.sbatch, array.sbatch, run.pbs, array.pbs):
-# configuration from the environment, the time left in the job (-> -max_walltime), launching
-# the run in the background with SIGUSR1/SIGTERM forwarded to it, and what to do with its exit
-# code (resubmit on 3, with a cap and a progress check). Sourced, never run; see jobs/README.md.
+# Shared logic of the morphogen job scripts (run.sbatch, array.sbatch, sweep_array.sbatch and
+# their .pbs twins): configuration from the environment, the time left in the job
+# (-> -max_walltime), launching the run in the background with SIGUSR1/SIGTERM forwarded to it,
+# and what to do with its exit code (resubmit on 3, with a cap and a progress check). Sourced,
+# never run; see jobs/README.md.
 #
 # A job script does:
 #   mg_init slurm|pbs SCRIPT_NAME "$@"   # read the configuration (exits 1 on a bad one)
-#   mg_member                             # arrays only: pick this task's member
+#   mg_member | mg_sweep_member           # arrays only: pick this task's member / sweep chunk
 #   mg_run                                # run morphogen, sets MG_RC
 #   mg_finish                             # exit code handling, resubmission; exits
 #
-# Exit codes of morphogen: 0 done, 1 bad input or diverged, 2 internal error, 3 checkpointed
-# on a signal or on -max_walltime (resubmit), 4 output write failed.
+# Exit codes of morphogen (runs and sweeps): 0 done, 1 bad input or diverged, 2 internal error,
+# 3 stopped on a signal or on -max_walltime, resumable (resubmit), 4 output write failed.
 
 MG_EXIT_DONE=0
 MG_EXIT_INPUT=1
@@ -241,20 +242,32 @@ mg_init() { # SCHED SCRIPT_NAME ARGS...
   MG_OUT=${MG_OUT:-morphogen_out}
   MG_MEMBER_ARGS=()
   MG_ARRAY_INDEX=""
+  # What mg_run launches: $MG_EXE MG_SUBCOMMAND [DECK] -output_dir OUT MG_CHUNK_ARGS ... (the
+  # two are set by mg_sweep_member), and how it measures progress (see mg__resubmit_refusal).
+  MG_SUBCOMMAND=()
+  MG_CHUNK_ARGS=()
+  MG_PROGRESS=mg_latest_checkpoint
+  MG_PROGRESS_UNIT=checkpoint
 }
 
-# Select this array task's ensemble member. Its index: MORPHOGEN_ARRAY_INDEX (set on a
-# resubmitted member), else the batch system's (SLURM_ARRAY_TASK_ID, PBS Pro PBS_ARRAY_INDEX,
-# Torque PBS_ARRAYID). With ENSEMBLE_FILE, the member's extra options are its INDEX-th member
-# line (numbered from 1; blank lines and lines starting with # do not count); without, the
-# member is -seed INDEX. Its output goes to OUT/member_NNNN.
-mg_member() {
+# This array task's index into MG_ARRAY_INDEX: MORPHOGEN_ARRAY_INDEX (set on a resubmitted
+# task), else the batch system's (SLURM_ARRAY_TASK_ID, PBS Pro PBS_ARRAY_INDEX, Torque
+# PBS_ARRAYID).
+mg__array_index() {
   local idx=${MORPHOGEN_ARRAY_INDEX:-${SLURM_ARRAY_TASK_ID:-${PBS_ARRAY_INDEX:-${PBS_ARRAYID:-}}}}
-  local line n=0 found=""
   mg_is_uint "$idx" ||
     mg_die 1 "not an array task (no SLURM_ARRAY_TASK_ID, PBS_ARRAY_INDEX, PBS_ARRAYID or MORPHOGEN_ARRAY_INDEX)"
-  idx=$((10#$idx))
-  MG_ARRAY_INDEX=$idx
+  MG_ARRAY_INDEX=$((10#$idx))
+}
+
+# Select this array task's ensemble member. Its index: see mg__array_index. With
+# ENSEMBLE_FILE, the member's extra options are its INDEX-th member line (numbered from 1; blank
+# lines and lines starting with # do not count); without, the member is -seed INDEX. Its output
+# goes to OUT/member_NNNN.
+mg_member() {
+  local idx line n=0 found=""
+  mg__array_index
+  idx=$MG_ARRAY_INDEX
   if [[ -n ${ENSEMBLE_FILE:-} ]]; then
     [[ -r $ENSEMBLE_FILE ]] || mg_die 1 "ENSEMBLE_FILE=$ENSEMBLE_FILE: not a readable file"
     while IFS= read -r line || [[ -n $line ]]; do
@@ -272,6 +285,76 @@ mg_member() {
     MG_MEMBER_ARGS=(-seed "$idx")
   fi
   MG_OUT=$(printf '%s/member_%04d' "$MG_OUT" "$idx")
+}
+
+# The progress measure of a sweep chunk (MG_PROGRESS): how many of the chunk's points are
+# finished in DIR (DIR/points/point_<p>.json with p mod MG_SWEEP_CHUNKS == MG_SWEEP_CHUNK, so
+# that concurrent chunks do not count), as "N finished points"; empty when none.
+mg_sweep_points_done() { # DIR
+  local f p n=0
+  for f in "$1"/points/point_*.json; do
+    [[ -e $f ]] || continue
+    p=${f##*/point_}
+    p=${p%.json}
+    mg_is_uint "$p" || continue
+    ((10#$p % MG_SWEEP_CHUNKS == MG_SWEEP_CHUNK)) && n=$((n + 1))
+  done
+  ((n == 0)) || printf '%d finished points' "$n"
+}
+
+# Make this array task run one chunk of a sweep: `$MORPHOGEN sweep DECK -output_dir OUT
+# -sweep_chunk c -sweep_chunks C ...` with c = INDEX - SWEEP_FIRST_INDEX (INDEX: see
+# mg__array_index) and C = SWEEP_CHUNKS. Without SWEEP_CHUNKS, the job array is the sweep: C is
+# its size and SWEEP_FIRST_INDEX defaults to its first index; the array must then be contiguous
+# (FIRST-LAST, step 1), read from SLURM_ARRAY_TASK_MIN/MAX (and _COUNT, _STEP) or from PBS Pro's
+# `qstat -f $PBS_ARRAY_ID` (array_indices_submitted). With SWEEP_CHUNKS, SWEEP_FIRST_INDEX
+# defaults to 0 (index i runs chunk i). Both are exported, so that a resubmitted task (a
+# one-index array, or a plain PBS job) keeps them. Progress for the resubmission check: more
+# finished points of this chunk.
+mg_sweep_member() {
+  local a first=${SWEEP_FIRST_INDEX:-} chunks=${SWEEP_CHUNKS:-} min="" max="" step="" count="" out
+  [[ -n $MG_DECK ]] || mg_die 1 "a sweep needs a deck (DECK, or the first script argument)"
+  for a in "${MG_EXTRA[@]}" "${MG_ARGS[@]}"; do
+    [[ $a == -sweep_chunk || $a == -sweep_chunks ]] &&
+      mg_die 1 "$a: the chunks are the array tasks (set by the script; see SWEEP_CHUNKS)"
+  done
+  mg__array_index
+  case $MG_SCHED in
+    slurm)
+      min=${SLURM_ARRAY_TASK_MIN:-} max=${SLURM_ARRAY_TASK_MAX:-}
+      step=${SLURM_ARRAY_TASK_STEP:-} count=${SLURM_ARRAY_TASK_COUNT:-}
+      ;;
+    pbs)
+      if [[ -z $first || -z $chunks ]] && [[ -n ${PBS_ARRAY_ID:-} ]] &&
+        out=$(qstat -f "$PBS_ARRAY_ID" 2>/dev/null) &&
+        [[ $out =~ array_indices_submitted[[:space:]]*=[[:space:]]*([0-9]+)-([0-9]+)(:([0-9]+))? ]]; then
+        min=${BASH_REMATCH[1]} max=${BASH_REMATCH[2]} step=${BASH_REMATCH[4]:-1}
+      fi
+      ;;
+  esac
+  if [[ -z $chunks ]]; then # the array is the sweep: chunk 0 is its first index
+    { mg_is_uint "$min" && mg_is_uint "$max"; } ||
+      mg_die 1 "the job array's index range is unknown: set SWEEP_CHUNKS (and SWEEP_FIRST_INDEX, default 0)"
+    chunks=$((10#$max - 10#$min + 1))
+    # contiguous: as many tasks as indices from min to max (else, without a count: step 1)
+    if mg_is_uint "$count" && ((10#$count != chunks)) ||
+      { ! mg_is_uint "$count" && mg_is_uint "$step" && ((10#$step != 1)); }; then
+      mg_die 1 "the job array ($min-$max, ${count:-?} tasks, step ${step:-?}) is not contiguous: use FIRST-LAST (e.g. 0-$((chunks - 1))), or set SWEEP_CHUNKS and SWEEP_FIRST_INDEX"
+    fi
+    first=${first:-$min}
+  fi
+  first=${first:-0} # SWEEP_CHUNKS given: index i is chunk i unless SWEEP_FIRST_INDEX says otherwise
+  { mg_is_uint "$chunks" && ((10#$chunks >= 1)); } || mg_die 1 "SWEEP_CHUNKS=$chunks: not a positive count"
+  mg_is_uint "$first" || mg_die 1 "SWEEP_FIRST_INDEX=$first: not an index"
+  export SWEEP_CHUNKS=$((10#$chunks)) SWEEP_FIRST_INDEX=$((10#$first))
+  MG_SWEEP_CHUNKS=$SWEEP_CHUNKS
+  MG_SWEEP_CHUNK=$((MG_ARRAY_INDEX - SWEEP_FIRST_INDEX))
+  ((MG_SWEEP_CHUNK >= 0 && MG_SWEEP_CHUNK < MG_SWEEP_CHUNKS)) ||
+    mg_die 1 "array index $MG_ARRAY_INDEX: chunk $MG_SWEEP_CHUNK is not in 0..$((MG_SWEEP_CHUNKS - 1)) (SWEEP_FIRST_INDEX=$SWEEP_FIRST_INDEX, SWEEP_CHUNKS=$SWEEP_CHUNKS)"
+  MG_SUBCOMMAND=(sweep)
+  MG_CHUNK_ARGS=(-sweep_chunk "$MG_SWEEP_CHUNK" -sweep_chunks "$MG_SWEEP_CHUNKS")
+  MG_PROGRESS=mg_sweep_points_done
+  MG_PROGRESS_UNIT="finished point of chunk $MG_SWEEP_CHUNK/$MG_SWEEP_CHUNKS"
 }
 
 # Forward a checkpoint request to the run. Always SIGUSR1, whatever arrived: morphogen treats
@@ -293,9 +376,9 @@ mg__on_signal() { # SIGNAME
 mg_run() {
   local minutes prev rc
   mkdir -p -- "$MG_OUT" || mg_die "$MG_EXIT_WRITE" "cannot create the output directory $MG_OUT"
-  MG_CMD=("$MG_EXE")
+  MG_CMD=("$MG_EXE" "${MG_SUBCOMMAND[@]}")
   [[ -n $MG_DECK ]] && MG_CMD+=("$MG_DECK")
-  MG_CMD+=(-output_dir "$MG_OUT" -restart latest)
+  MG_CMD+=(-output_dir "$MG_OUT" "${MG_CHUNK_ARGS[@]}" -restart latest)
   local a user_walltime=""
   for a in "${MG_EXTRA[@]}" "${MG_ARGS[@]}" "${MG_MEMBER_ARGS[@]}"; do
     [[ $a == -max_walltime ]] && user_walltime=1
@@ -305,8 +388,8 @@ mg_run() {
   fi
   MG_CMD+=("${MG_EXTRA[@]}" "${MG_ARGS[@]}" "${MG_MEMBER_ARGS[@]}")
 
-  MG_CKPT_BEFORE=$(mg_latest_checkpoint "$MG_OUT")
-  mg_note "segment $((MG_COUNT + 1)) of at most $((MG_MAX + 1)) starts${MG_CKPT_BEFORE:+ from $MG_CKPT_BEFORE}: $(mg_quote "${MG_LAUNCHER[@]}" "${MG_CMD[@]}")"
+  MG_PROGRESS_BEFORE=$("$MG_PROGRESS" "$MG_OUT")
+  mg_note "segment $((MG_COUNT + 1)) of at most $((MG_MAX + 1)) starts${MG_PROGRESS_BEFORE:+ from $MG_PROGRESS_BEFORE}: $(mg_quote "${MG_LAUNCHER[@]}" "${MG_CMD[@]}")"
 
   MG_TRAPPED=0 MG_GOT_TERM=0 MG_PENDING=0 MG_CHILD=""
   trap 'mg__on_signal USR1' USR1
@@ -338,7 +421,10 @@ mg_run() {
   MG_RC=$rc
 }
 
-# Whether a run that stopped with exit code 3 may be resubmitted; prints the reason if not.
+# Whether a run that stopped with exit code 3 may be resubmitted; prints the reason if not. A
+# run made progress when the measure $MG_PROGRESS prints for MG_OUT (the newest checkpoint's
+# name; for sweeps the chunk's number of finished points) is not empty afterwards and differs
+# from the one before.
 mg__resubmit_refusal() {
   local after
   if ((MG_COUNT >= MG_MAX)); then
@@ -350,9 +436,10 @@ mg__resubmit_refusal() {
     return 0
   fi
   if [[ ${MORPHOGEN_REQUIRE_PROGRESS:-1} == 1 ]]; then
-    after=$(mg_latest_checkpoint "$MG_OUT")
-    if [[ -z $after || $after == "$MG_CKPT_BEFORE" ]]; then
-      printf 'no new checkpoint in %s (newest: %s): the run made no progress' "$MG_OUT" "${after:-none}"
+    after=$("$MG_PROGRESS" "$MG_OUT")
+    if [[ -z $after || $after == "$MG_PROGRESS_BEFORE" ]]; then
+      printf 'no new %s in %s (before: %s, now: %s): the run made no progress' \
+        "$MG_PROGRESS_UNIT" "$MG_OUT" "${MG_PROGRESS_BEFORE:-none}" "${after:-none}"
       return 0
     fi
   fi
@@ -407,7 +494,7 @@ mg_resubmit() {
 }
 
 # Act on the run's exit code and exit: 0 when done or handed over to a resubmitted job, 3 when
-# it stopped at a checkpoint and was not resubmitted, otherwise morphogen's code.
+# it stopped early (exit 3) and was not resubmitted, otherwise morphogen's code.
 mg_finish() {
   local why
   case $MG_RC in
@@ -417,13 +504,13 @@ mg_finish() {
       ;;
     "$MG_EXIT_RESUBMIT")
       if why=$(mg__resubmit_refusal); then
-        mg_note "run stopped at a checkpoint (exit 3), not resubmitted: $why; submit again to continue"
+        mg_note "run stopped early (exit 3, resumable), not resubmitted: $why; submit again to continue"
         exit "$MG_EXIT_RESUBMIT"
       fi
       if mg_resubmit; then
         exit 0
       fi
-      mg_note "run stopped at a checkpoint (exit 3), resubmission failed; submit again to continue"
+      mg_note "run stopped early (exit 3, resumable), resubmission failed; submit again to continue"
       exit "$MG_EXIT_RESUBMIT"
       ;;
     "$MG_EXIT_INPUT") why="bad input or diverged run" ;;

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <unistd.h>
 
 namespace morphogen::io {
 
@@ -58,7 +59,10 @@ std::string xmf_grid(const SeriesEntry& e) {
 } // namespace
 
 std::string write_file_atomically(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
+  // A temporary name of this writer's own: chunks of a sweep may write the same file at once.
+  char host[256] = "";
+  gethostname(host, sizeof host - 1);
+  const std::string tmp = path + ".tmp." + host + "." + std::to_string(getpid());
   {
     std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
     f << text;

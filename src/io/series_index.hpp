@@ -46,7 +46,8 @@ private:
   std::vector<SeriesEntry> entries_;
 };
 
-// Writes `text` to `path` via a temporary file and rename. Returns "" or the error.
+// Writes `text` to `path` via a temporary file (unique to this host and process) and rename.
+// Returns "" or the error.
 std::string write_file_atomically(const std::string& path, const std::string& text);
 
 } // namespace morphogen::io

@@ -2,7 +2,8 @@
 without a cluster. Fake srun/mpiexec, sbatch/qsub, squeue/scontrol/qstat executables on PATH
 record what the scripts ask of the batch system; a resubmission is followed by running the
 recorded submission (script, arguments, environment) as the next job of the chain. The last
-test drives the real morphogen binary through a checkpoint on SIGUSR1 and a restart."""
+tests drive the real morphogen binary through a checkpoint on SIGUSR1 and a restart, and through
+a chunked sweep (sweep_array.sbatch)."""
 import glob
 import os
 import shutil
@@ -23,7 +24,8 @@ SCRIPTS = sorted(glob.glob(os.path.join(JOBS, "*.sbatch")) + glob.glob(os.path.j
 # Fake srun / mpiexec: records its arguments (one per line) and the signals it gets; exit code of
 # call n is the n-th word of FAKE_EXIT_CODES (the last one repeats). With FAKE_WAIT_SIGNAL=1 it
 # waits for FAKE_SIGNALS_NEEDED (default 1) signals, SIGUSR1 or SIGTERM, first. On exit code 3 it leaves a checkpoint in -output_dir, as
-# morphogen would (unless FAKE_CHECKPOINT=0).
+# morphogen would (unless FAKE_CHECKPOINT=0). Sweeps: call n writes the finished points listed in
+# the n-th ";"-separated field of FAKE_POINTS (point indices) as -output_dir/points/point_NNNNNN.json.
 FAKE_LAUNCHER = r"""#!/bin/bash
 state=$FAKE_STATE
 n=$(( $(cat "$state/launch.count" 2>/dev/null || echo 0) + 1 ))
@@ -40,6 +42,10 @@ if [[ ${FAKE_WAIT_SIGNAL:-0} == 1 ]]; then
   echo $$ > "$state/launch.ready"
   while ((got < ${FAKE_SIGNALS_NEEDED:-1})); do sleep 0.02; done
 fi
+IFS=';' read -r -a points <<< "${FAKE_POINTS:-}"
+for p in ${points[n-1]:-}; do
+  mkdir -p "$out/points" && : > "$out/points/$(printf 'point_%06d.json' "$p")"
+done
 if [[ $code == 3 && ${FAKE_CHECKPOINT:-1} == 1 && -n $out ]]; then
   : > "$out/$(printf 'checkpoint_%07d.vtkhdf' $((n * 100)))"
 fi
@@ -75,7 +81,7 @@ printf 'Job Id: %s\n%s\n' "$2" "$FAKE_QSTAT"
 
 # Variables of a real job environment or of the caller that would change what the scripts do.
 SCRUB = ("SLURM_", "SBATCH_", "PBS_", "MORPHOGEN_", "FAKE_")
-SCRUB_NAMES = {"DECK", "OUT", "EXTRA_ARGS", "ENSEMBLE_FILE"}
+SCRUB_NAMES = {"DECK", "OUT", "EXTRA_ARGS", "ENSEMBLE_FILE", "SWEEP_CHUNKS", "SWEEP_FIRST_INDEX"}
 
 
 class Cluster:
@@ -151,8 +157,10 @@ class Cluster:
         if script.endswith(".sbatch"):
             env.update(SLURM_JOB_ID=str(job_id), SLURM_JOB_NAME="morphogen", SLURM_SUBMIT_DIR=str(self.tmp))
             for o in opts:
-                if o.startswith("--array="):
-                    env["SLURM_ARRAY_TASK_ID"] = o.split("=", 1)[1]
+                if o.startswith("--array="):  # a one-index array, as SLURM describes it
+                    index = o.split("=", 1)[1]
+                    env.update(SLURM_ARRAY_TASK_ID=index, SLURM_ARRAY_TASK_MIN=index, SLURM_ARRAY_TASK_MAX=index,
+                               SLURM_ARRAY_TASK_COUNT="1")
         else:
             env.update(PBS_JOBID=f"{job_id}.pbs", PBS_O_WORKDIR=str(self.tmp))
         return subprocess.run(["bash", script, *script_args], env=env, cwd=self.tmp, capture_output=True,
@@ -182,7 +190,8 @@ def wait_for(path, proc, timeout=30):
 
 def test_all_scripts_present():
     names = {os.path.basename(s) for s in SCRIPTS}
-    assert {"run.sbatch", "array.sbatch", "run.pbs", "array.pbs", "lib_morphogen.sh"} <= names
+    assert {"run.sbatch", "array.sbatch", "sweep_array.sbatch", "run.pbs", "array.pbs", "sweep_array.pbs",
+            "lib_morphogen.sh"} <= names
 
 
 @pytest.mark.parametrize("script", SCRIPTS, ids=os.path.basename)
@@ -233,6 +242,22 @@ def test_latest_checkpoint(tmp_path):
     (tmp_path / "checkpoint_latest.vtkhdf").write_text("")
     assert lib(f'mg_latest_checkpoint "{tmp_path}"') == (0, "checkpoint_99999999.vtkhdf")
     assert lib(f'mg_latest_checkpoint "{tmp_path}/none"') == (0, "")
+
+
+def test_sweep_points_done(tmp_path):
+    """A chunk's progress: its own finished points only (p mod C == c), not other files."""
+    points = tmp_path / "points"
+    points.mkdir()
+    for p in range(10):
+        (points / f"point_{p:06d}.json").write_text("{}")
+    for name in ("point_000011.json.tmp", "point_000011.vtkhdf", "point_x.json", "sweep.json"):
+        (points / name).write_text("")
+    count = 'MG_SWEEP_CHUNK={} MG_SWEEP_CHUNKS={}; mg_sweep_points_done "{}"'
+    assert lib(count.format(1, 4, tmp_path)) == (0, "3 finished points")  # 1 5 9
+    assert lib(count.format(3, 4, tmp_path)) == (0, "2 finished points")  # 3 7
+    assert lib(count.format(0, 1, tmp_path)) == (0, "10 finished points")
+    assert lib(count.format(10, 11, tmp_path)) == (0, "")
+    assert lib(count.format(0, 1, tmp_path / "none")) == (0, "")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -518,6 +543,149 @@ def test_array_pbs_member_resubmitted_as_single_job(cluster):
 
 
 # ---------------------------------------------------------------------------------------------
+# Sweeps in chunks (sweep_array.sbatch, sweep_array.pbs)
+
+def sweep_env(cluster, index, first=0, last=3, **extra):
+    """The environment of SLURM array task INDEX of --array=FIRST-LAST."""
+    return cluster.slurm_env(SLURM_ARRAY_TASK_ID=str(index), SLURM_ARRAY_TASK_MIN=str(first),
+                             SLURM_ARRAY_TASK_MAX=str(last), SLURM_ARRAY_TASK_COUNT=str(last - first + 1),
+                             SLURM_ARRAY_TASK_STEP="1", SLURM_ARRAY_JOB_ID="999", **extra)
+
+
+@pytest.mark.parametrize("index,first,last,chunk,chunks", [
+    (0, 0, 3, 0, 4), (2, 0, 3, 2, 4), (3, 0, 3, 3, 4),  # --array=0-3
+    (1, 1, 8, 0, 8), (8, 1, 8, 7, 8),  # --array=1-8: the offset is the first index
+    (0, 0, 0, 0, 1),  # --array=0: the whole sweep in one task
+])
+def test_sweep_array_chunk_command_line(cluster, index, first, last, chunk, chunks):
+    env = sweep_env(cluster, index, first, last, EXTRA_ARGS='-grid_n 32,32 -sweep_params_F "linspace(0.01, 0.07, 4)"',
+                    FAKE_EXIT_CODES="0")
+    res = cluster.run("sweep_array.sbatch", env, [DECK, "-steps", "500"])
+    assert res.returncode == 0, res.stderr
+    # one output directory for all chunks (no member_NNNN)
+    assert cluster.launch_args(1) == ["/bin/true", "sweep", DECK, "-output_dir", cluster.out,
+                                      "-sweep_chunk", str(chunk), "-sweep_chunks", str(chunks),
+                                      "-restart", "latest", "-max_walltime", "56", "-grid_n", "32,32",
+                                      "-sweep_params_F", "linspace(0.01, 0.07, 4)", "-steps", "500"]
+    assert cluster.count("submit") == 0
+    assert "run finished (exit 0)" in cluster.history()
+
+
+@pytest.mark.parametrize("extra,index,chunk,chunks", [
+    (dict(SWEEP_CHUNKS="8"), 5, 5, 8),  # e.g. SWEEP_CHUNKS=8 sbatch --array=3,5: index i is chunk i
+    (dict(SWEEP_CHUNKS="8", SWEEP_FIRST_INDEX="2"), 5, 3, 8),
+    (dict(SWEEP_FIRST_INDEX="3"), 5, 2, 4),  # size from the array, offset given
+])
+def test_sweep_array_chunks_from_environment(cluster, extra, index, chunk, chunks):
+    env = sweep_env(cluster, index, 3, 6, FAKE_EXIT_CODES="0", **extra)
+    res = cluster.run("sweep_array.sbatch", env, [DECK])
+    assert res.returncode == 0, res.stderr
+    assert cluster.launch_args(1)[5:9] == ["-sweep_chunk", str(chunk), "-sweep_chunks", str(chunks)]
+
+
+@pytest.mark.parametrize("extra,args,message", [
+    (dict(SLURM_ARRAY_TASK_ID="4", SLURM_ARRAY_TASK_MAX="14", SLURM_ARRAY_TASK_COUNT="8",
+          SLURM_ARRAY_TASK_STEP="2"), [DECK], "not contiguous"),  # --array=0-14:2
+    (dict(SLURM_ARRAY_TASK_ID="5", SLURM_ARRAY_TASK_MAX="9", SLURM_ARRAY_TASK_COUNT="3",
+          SLURM_ARRAY_TASK_STEP=""), [DECK], "not contiguous"),  # --array=1,5,9
+    (dict(SLURM_ARRAY_TASK_ID="4", SLURM_ARRAY_TASK_MAX="14", SLURM_ARRAY_TASK_COUNT="",
+          SLURM_ARRAY_TASK_STEP="2"), [DECK], "not contiguous"),  # no count: the step tells
+    (dict(SLURM_ARRAY_TASK_ID="5", SLURM_ARRAY_TASK_MIN="", SLURM_ARRAY_TASK_MAX="",
+          SLURM_ARRAY_TASK_COUNT=""), [DECK], "index range is unknown"),
+    (dict(SLURM_ARRAY_TASK_ID="5", SWEEP_CHUNKS="4"), [DECK], "chunk 5 is not in 0..3"),
+    (dict(SWEEP_CHUNKS="0"), [DECK], "SWEEP_CHUNKS=0"),
+    (dict(SLURM_ARRAY_TASK_ID=""), [DECK], "not an array task"),
+    ({}, ["-steps", "5"], "a sweep needs a deck"),
+    ({}, [DECK, "-sweep_chunk", "1"], "-sweep_chunk: the chunks are the array tasks"),
+    (dict(EXTRA_ARGS="-sweep_chunks 3"), [DECK], "-sweep_chunks: the chunks are the array tasks"),
+])
+def test_sweep_array_bad_configuration(cluster, extra, args, message):
+    env = sweep_env(cluster, 1, 0, 3)
+    env.update(extra)
+    res = cluster.run("sweep_array.sbatch", {k: v for k, v in env.items() if v != ""}, args)
+    assert res.returncode == 1 and message in res.stderr, res.stderr
+    assert cluster.count("launch") == 0
+
+
+def test_sweep_array_resubmits_its_chunk_while_it_finishes_points(cluster):
+    """Exit 3 -> resubmission of that index only, as long as the chunk finished more of its own
+    points; a checkpoint or another chunk's points are not progress."""
+    # --array=1-4: task 3 is chunk 2 of 4 (points 2, 6, 10, ...). Call 1 finishes points 2 and
+    # 3 (the latter another chunk's), call 2 point 6, call 3 only point 7 (another chunk's).
+    env = sweep_env(cluster, 3, 1, 4, FAKE_EXIT_CODES="3", FAKE_POINTS="2 3;6;7")
+    res = cluster.run("sweep_array.sbatch", env, [DECK])
+    assert res.returncode == 0, res.stderr  # handed over to the resubmitted job
+    args = cluster.launch_args(1)
+    assert args[:9] == ["/bin/true", "sweep", DECK, "-output_dir", cluster.out, "-sweep_chunk", "2",
+                        "-sweep_chunks", "4"]
+    assert cluster.submit_args(1) == ["--export=ALL", "--job-name=morphogen", "--array=3",
+                                      os.path.join(JOBS, "sweep_array.sbatch"), DECK]
+    sub = cluster.submit_env(1)
+    assert (sub["SWEEP_CHUNKS"], sub["SWEEP_FIRST_INDEX"], sub["MORPHOGEN_RESUBMIT_COUNT"]) == ("4", "1", "1")
+    assert not any(k.startswith("SLURM_ARRAY") for k in sub)
+    # the resubmitted job is a one-index array (3-3): still chunk 2 of 4
+    res = cluster.follow(1, 1001)
+    assert res.returncode == 0, res.stderr
+    assert cluster.launch_args(2) == args and cluster.count("submit") == 2
+    res = cluster.follow(2, 1002)
+    assert res.returncode == 3, res.stderr
+    assert cluster.launch_args(3) == args and cluster.count("submit") == 2
+    assert "no new finished point of chunk 2/4" in res.stderr
+    assert "(before: 2 finished points, now: 2 finished points)" in res.stderr
+    log = cluster.history()
+    assert "segment 1 of at most 11 starts: srun /bin/true sweep" in log
+    assert "segment 3 of at most 11 starts from 2 finished points: " in log
+    assert log.count("resubmitted (") == 2 and "not resubmitted" in log
+
+
+def test_sweep_array_no_points_no_resubmission(cluster):
+    env = sweep_env(cluster, 0, FAKE_EXIT_CODES="3")  # leaves a checkpoint, no point
+    res = cluster.run("sweep_array.sbatch", env, [DECK])
+    assert res.returncode == 3 and cluster.count("submit") == 0
+    assert "no new finished point of chunk 0/4 in " in res.stderr
+    env["MORPHOGEN_REQUIRE_PROGRESS"] = "0"
+    assert cluster.run("sweep_array.sbatch", env, [DECK]).returncode == 0
+    assert cluster.count("submit") == 1
+
+
+def test_sweep_array_signal_forwarded(cluster):
+    """--signal=B:USR1@...: the sweep gets SIGUSR1, stops with exit 3 after finishing a point."""
+    env = sweep_env(cluster, 1, FAKE_EXIT_CODES="3", FAKE_WAIT_SIGNAL="1", FAKE_POINTS="1")
+    proc = cluster.start("sweep_array.sbatch", env, [DECK])
+    rc, err = send_signal_when_ready(cluster, proc, signal.SIGUSR1)
+    assert cluster.signals() == ["USR1"], err
+    assert rc == 0 and cluster.count("submit") == 1, err
+
+
+def test_sweep_array_pbs(cluster):
+    """PBS Pro qsub -J 0-2: the range from qstat -f; the chunk comes back as a plain job."""
+    qstat = ("    Resource_List.walltime = 02:00:00\n    resources_used.walltime = 00:00:30\n"
+             "    array = True\n    array_indices_submitted = 0-2\n")
+    env = cluster.pbs_env(DECK=DECK, PBS_ARRAY_INDEX="1", PBS_ARRAY_ID="1000[].pbs", FAKE_QSTAT=qstat,
+                          EXTRA_ARGS="-steps 500", FAKE_EXIT_CODES="3 0", FAKE_POINTS="1 2")
+    res = cluster.run("sweep_array.pbs", env)
+    assert res.returncode == 0, res.stderr
+    args = cluster.launch_args(1)
+    assert args == ["/bin/true", "sweep", DECK, "-output_dir", cluster.out, "-sweep_chunk", "1",
+                    "-sweep_chunks", "3", "-restart", "latest", "-max_walltime", "115", "-steps", "500"]
+    assert cluster.submit_args(1) == ["-V", "-N", "morphogen", os.path.join(JOBS, "sweep_array.pbs")]
+    sub = cluster.submit_env(1)
+    assert (sub["MORPHOGEN_ARRAY_INDEX"], sub["SWEEP_CHUNKS"], sub["SWEEP_FIRST_INDEX"]) == ("1", "3", "0")
+    assert "PBS_ARRAY_INDEX" not in sub and "PBS_ARRAY_ID" not in sub
+    assert cluster.follow(1, 1001).returncode == 0
+    assert cluster.launch_args(2) == args and cluster.count("submit") == 1
+
+
+def test_sweep_array_pbs_torque_needs_sweep_chunks(cluster):
+    env = cluster.pbs_env(DECK=DECK, PBS_ARRAYID="1", FAKE_EXIT_CODES="0")  # qsub -t: no range known
+    res = cluster.run("sweep_array.pbs", env)
+    assert res.returncode == 1 and "set SWEEP_CHUNKS" in res.stderr
+    env["SWEEP_CHUNKS"] = "2"
+    assert cluster.run("sweep_array.pbs", env).returncode == 0
+    assert cluster.launch_args(1)[5:9] == ["-sweep_chunk", "1", "-sweep_chunks", "2"]
+
+
+# ---------------------------------------------------------------------------------------------
 # The real binary: SIGUSR1 -> checkpoint, exit 3 -> resubmission -> restart -> done
 
 def test_real_morphogen_signal_checkpoint_restart(cluster):
@@ -550,3 +718,80 @@ def test_real_morphogen_signal_checkpoint_restart(cluster):
     assert os.path.exists(os.path.join(out, "a_final.png"))
     log = cluster.history()
     assert f"starts from {os.path.basename(first)}" in log and "run finished (exit 0)" in log
+
+
+# The real binary as a sweep: a fake srun that records its arguments and runs the rest on one rank.
+REAL_SRUN = r"""#!/bin/bash
+n=$(( $(cat "$FAKE_STATE/launch.count" 2>/dev/null || echo 0) + 1 ))
+echo "$n" > "$FAKE_STATE/launch.count"
+printf '%s\n' "$@" > "$FAKE_STATE/launch.args.$n"
+exec "$REAL_MPIEXEC" --oversubscribe -n 1 "$@"
+"""
+
+TINY_SWEEP = ("-grid_n 16,16 -grid_L 0.15625 -steps 200 -sweep_params_F 0.03,0.04 "
+              "-sweep_params_k 0.06,0.065")
+
+
+def real_sweep_env(cluster, index, last, extra_args):
+    (cluster.bin / "srun").write_text(REAL_SRUN)
+    return sweep_env(cluster, index, 0, last, MORPHOGEN=EXE, REAL_MPIEXEC=MPIEXEC, EXTRA_ARGS=extra_args,
+                     OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+                     OMPI_MCA_rmaps_base_oversubscribe="1")
+
+
+def finished_points(out):
+    return sorted(os.path.basename(f) for f in glob.glob(os.path.join(out, "points", "point_*.json")))
+
+
+def test_real_sweep_two_chunks_finish_all_points(cluster):
+    """Array --array=0-1 on a 2 x 2 sweep: each task runs its chunk, together all 4 points."""
+    sweep_deck = os.path.join(SOURCE, "input", "gray_scott_sweep.yaml")
+    for index, points in ((0, ["point_000000.json", "point_000002.json"]), (1, ["point_000001.json",
+                                                                              "point_000003.json"])):
+        res = cluster.run("sweep_array.sbatch", real_sweep_env(cluster, index, 1, TINY_SWEEP), [sweep_deck],
+                          timeout=120)
+        assert res.returncode == 0, res.stdout + res.stderr
+        assert f"chunk {index}/2: 2 to run, " in res.stdout
+        assert cluster.launch_args(index + 1)[5:11] == ["-sweep_chunk", str(index), "-sweep_chunks", "2",
+                                                         "-restart", "latest"]
+        assert set(points) <= set(finished_points(cluster.out))
+    assert finished_points(cluster.out) == [f"point_{p:06d}.json" for p in range(4)]
+    with open(os.path.join(cluster.out, "sweep.csv")) as f:
+        assert len(f.read().strip().splitlines()) == 1 + 4  # header, one row per point
+    assert cluster.count("submit") == 0
+    assert cluster.history().count("run finished (exit 0)") == 2
+    # a chunk that is done stays done
+    res = cluster.run("sweep_array.sbatch", real_sweep_env(cluster, 0, 1, TINY_SWEEP), [sweep_deck], timeout=120)
+    assert res.returncode == 0 and "chunk 0/2: 0 to run, 4 already done" in res.stdout, res.stdout + res.stderr
+
+
+def test_real_sweep_signal_resubmit_resume(cluster):
+    """SIGUSR1 to the batch shell while chunk 0 of 2 runs its second point (about a second each):
+    that point is abandoned, exit 3 with one point more -> resubmission -> the resubmitted job
+    runs only the remaining point."""
+    sweep_deck = os.path.join(SOURCE, "input", "gray_scott_sweep.yaml")
+    slow = "-grid_n 64,64 -steps 50000 -sweep_params_F 0.03,0.04 -sweep_params_k 0.06,0.065"
+    proc = cluster.start("sweep_array.sbatch", real_sweep_env(cluster, 0, 1, slow), [sweep_deck])
+    try:
+        deadline = time.monotonic() + 120
+        while not finished_points(cluster.out):
+            if proc.poll() is not None:
+                pytest.fail(f"sweep ended before its first point ({proc.returncode}): {proc.communicate()}")
+            assert time.monotonic() < deadline, "no finished point within 120 s"
+            time.sleep(0.05)
+        proc.send_signal(signal.SIGUSR1)
+        stdout, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 0, stdout + err  # exit 3 with progress: resubmitted
+    assert "stopped by a signal" in stdout + err
+    assert finished_points(cluster.out) == ["point_000000.json"]
+    assert cluster.count("submit") == 1 and "--array=0" in cluster.submit_args(1)
+    res = cluster.follow(1, 1001)
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert "chunk 0/2: 1 to run, 1 already done" in res.stdout
+    assert finished_points(cluster.out) == ["point_000000.json", "point_000002.json"]
+    assert cluster.count("submit") == 1
+    log = cluster.history()
+    assert "starts from 1 finished points" in log and "run finished (exit 0)" in log
