@@ -23,10 +23,13 @@ enum : int { kSigUsr1 = 1, kSigTerm = 2, kWallCheckpoint = 4, kWallBudget = 8 };
 std::string library_versions(std::string& hdf5) {
   char petsc[256];
   PetscGetVersion(petsc, sizeof petsc);
+  std::string v = petsc;
+  while (!v.empty() && v.back() == ' ')
+    v.pop_back();
   unsigned maj = 0, min = 0, rel = 0;
   H5get_libversion(&maj, &min, &rel);
   hdf5 = std::to_string(maj) + "." + std::to_string(min) + "." + std::to_string(rel);
-  return petsc;
+  return v;
 }
 
 // Next multiple of `every` strictly after t (with a relative tolerance for rounding).
