@@ -2,7 +2,7 @@
 // time series with a known class.
 //
 // Fields: hexagonal spots (three cosines on a 128 x 148 torus, 64 spots, wavelength 16 cells:
-// see test_pattern_metrics.cpp), their negative (holes), stripes along and oblique to the axes,
+// see synthetic_fields.hpp), their negative (holes), stripes along and oblique to the axes,
 // a labyrinth (hash noise band-passed to |k| within 15 % of 16 cycles per 256 cells, then
 // tanh), a half-spots half-stripes mixture, a uniform field with and without tiny noise, and
 // a NaN. Series: a travelling wave cos(kx - wt) (point probe, mean of half the domain),
@@ -10,6 +10,7 @@
 // Tolerances: wavelength 3 %, spot counts exact, periods 5 % (the estimator is far better).
 #include "analysis/classify.hpp"
 #include "core/hash_rng.hpp"
+#include "synthetic_fields.hpp"
 
 #include <fftw3.h>
 #include <gtest/gtest.h>
@@ -20,45 +21,9 @@
 #include <vector>
 
 using namespace morphogen::analysis;
+using namespace morphogen::testing;
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-struct Field {
-  FieldShape2D shape;
-  std::vector<double> u;
-  double& at(int i, int j) { return u[i + static_cast<std::size_t>(shape.nx) * j]; }
-};
-
-Field make(int nx, int ny) {
-  Field f;
-  f.shape = FieldShape2D{nx, ny, 1.0, 1.0, true, true};
-  f.u.assign(static_cast<std::size_t>(nx) * ny, 0.0);
-  return f;
-}
-
-double hex_value(int i, int j) {
-  const double x = i + 0.5, y = j + 0.5;
-  return std::cos(2 * kPi * 8 * x / 128) + std::cos(2 * kPi * (-4 * x / 128 + 8 * y / 148)) +
-         std::cos(2 * kPi * (-4 * x / 128 - 8 * y / 148));
-}
-
-Field hexagonal() {
-  Field f = make(128, 148);
-  for (int j = 0; j < 148; ++j)
-    for (int i = 0; i < 128; ++i)
-      f.at(i, j) = hex_value(i, j);
-  return f;
-}
-
-Field stripes(int n, int a, int b) {
-  Field f = make(n, n);
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i)
-      f.at(i, j) = std::cos(2 * kPi * (a * (i + 0.5) + b * (j + 0.5)) / n);
-  return f;
-}
 
 // Hash noise band-passed to |k| in [0.85, 1.15] * 16 cycles per 256 cells, then tanh(3 u / std).
 Field labyrinth(std::uint64_t seed) {

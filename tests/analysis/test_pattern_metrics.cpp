@@ -1,10 +1,9 @@
 // Serial tests for src/analysis/pattern_metrics: synthetic fields with known truth.
 //
-// Hexagonal spots: f = cos(k1.x) + cos(k2.x) + cos(k3.x) with k1 = 2 pi (8/Lx, 0),
-// k2,3 = 2 pi (-4/Lx, +-8/Ly) on a 128 x 148 torus: |k2| / |k1| = 0.9991 (a 0.09 % departure
-// from 120 degrees, the closest integer lattice), exactly periodic, wavelength 16 cells, and
-// det [[8, 0], [-4, 8]] = 64 maxima. Tolerances: wavelength within 3 %, spot counts exact.
+// Hexagonal spots (64 maxima, wavelength 16 cells, on a 128 x 148 torus) and stripes: see
+// synthetic_fields.hpp; discs below. Tolerances: wavelength within 3 %, spot counts exact.
 #include "analysis/pattern_metrics.hpp"
+#include "synthetic_fields.hpp"
 
 #include <gtest/gtest.h>
 
@@ -14,45 +13,9 @@
 #include <vector>
 
 using namespace morphogen::analysis;
+using namespace morphogen::testing;
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-struct Field {
-  FieldShape2D shape;
-  std::vector<double> u;
-  double& at(int i, int j) { return u[i + static_cast<std::size_t>(shape.nx) * j]; }
-};
-
-Field make(int nx, int ny, double h = 1.0) {
-  Field f;
-  f.shape = FieldShape2D{nx, ny, h, h, true, true};
-  f.u.assign(static_cast<std::size_t>(nx) * ny, 0.0);
-  return f;
-}
-
-// Sum of three cosines on the 128 x 148 torus (see the header comment); h the spacing.
-Field hexagonal(double h = 1.0) {
-  Field f = make(128, 148, h);
-  const double Lx = 128 * h, Ly = 148 * h;
-  for (int j = 0; j < 148; ++j)
-    for (int i = 0; i < 128; ++i) {
-      const double x = (i + 0.5) * h, y = (j + 0.5) * h;
-      f.at(i, j) = std::cos(2 * kPi * 8 * x / Lx) + std::cos(2 * kPi * (-4 * x / Lx + 8 * y / Ly)) +
-                   std::cos(2 * kPi * (-4 * x / Lx - 8 * y / Ly));
-    }
-  return f;
-}
-
-// cos(2 pi (a i / nx + b j / ny)): stripes with a + b*i wave vector, commensurate with the torus.
-Field stripes(int n, int a, int b) {
-  Field f = make(n, n);
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i)
-      f.at(i, j) = std::cos(2 * kPi * (a * (i + 0.5) + b * (j + 0.5)) / n);
-  return f;
-}
 
 // 1 inside the disc of radius r about (cx, cy) (minimum image: the disc wraps), else 0; the
 // shape is analysed as periodic or not.

@@ -688,6 +688,24 @@ def test_sweep_array_pbs_torque_needs_sweep_chunks(cluster):
 # ---------------------------------------------------------------------------------------------
 # The real binary: SIGUSR1 -> checkpoint, exit 3 -> resubmission -> restart -> done
 
+def send_usr1_when(proc, ready, timeout, ended, missing):
+    """Poll ready() every 50 ms while the batch shell runs (pytest.fail "<ended> (rc): output" if
+    it ends first; assert "<missing> within <timeout> s" past timeout), then send it SIGUSR1 and
+    let it finish; returns (stdout, stderr). Kills the shell if it is still running on the way out."""
+    try:
+        deadline = time.monotonic() + timeout
+        while not ready():
+            if proc.poll() is not None:
+                pytest.fail(f"{ended} ({proc.returncode}): {proc.communicate()}")
+            assert time.monotonic() < deadline, f"{missing} within {timeout} s"
+            time.sleep(0.05)
+        proc.send_signal(signal.SIGUSR1)
+        return proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+
+
 def test_real_morphogen_signal_checkpoint_restart(cluster):
     out = cluster.out
     steps = 60000
@@ -696,18 +714,8 @@ def test_real_morphogen_signal_checkpoint_restart(cluster):
         EXTRA_ARGS=f"-grid_n 16,16 -steps {steps} -checkpoint_every 1000 -png_every 0",
         OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_rmaps_base_oversubscribe="1")
     proc = cluster.start("run.sbatch", env)
-    try:
-        deadline = time.monotonic() + 60
-        while not glob.glob(os.path.join(out, "checkpoint_*.vtkhdf")):
-            if proc.poll() is not None:
-                pytest.fail(f"run ended before its first checkpoint ({proc.returncode}): {proc.communicate()}")
-            assert time.monotonic() < deadline, "no checkpoint within 60 s"
-            time.sleep(0.05)
-        proc.send_signal(signal.SIGUSR1)
-        stdout, err = proc.communicate(timeout=120)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
+    stdout, err = send_usr1_when(proc, lambda: glob.glob(os.path.join(out, "checkpoint_*.vtkhdf")), 60,
+                                 "run ended before its first checkpoint", "no checkpoint")
     assert proc.returncode == 0, stdout + err  # exit 3, resubmitted
     assert cluster.count("submit") == 1
     first = sorted(glob.glob(os.path.join(out, "checkpoint_*.vtkhdf")))[-1]
@@ -772,18 +780,8 @@ def test_real_sweep_signal_resubmit_resume(cluster):
     sweep_deck = os.path.join(SOURCE, "input", "gray_scott_sweep.yaml")
     slow = "-grid_n 64,64 -steps 50000 -sweep_params_F 0.03,0.04 -sweep_params_k 0.06,0.065"
     proc = cluster.start("sweep_array.sbatch", real_sweep_env(cluster, 0, 1, slow), [sweep_deck])
-    try:
-        deadline = time.monotonic() + 120
-        while not finished_points(cluster.out):
-            if proc.poll() is not None:
-                pytest.fail(f"sweep ended before its first point ({proc.returncode}): {proc.communicate()}")
-            assert time.monotonic() < deadline, "no finished point within 120 s"
-            time.sleep(0.05)
-        proc.send_signal(signal.SIGUSR1)
-        stdout, err = proc.communicate(timeout=120)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
+    stdout, err = send_usr1_when(proc, lambda: finished_points(cluster.out), 120,
+                                 "sweep ended before its first point", "no finished point")
     assert proc.returncode == 0, stdout + err  # exit 3 with progress: resubmitted
     assert "stopped by a signal" in stdout + err
     assert finished_points(cluster.out) == ["point_000000.json"]

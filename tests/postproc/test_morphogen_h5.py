@@ -10,8 +10,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "app"))
-from conftest import SOURCE, run  # noqa: E402
+from conftest import SOURCE, launch_runs, option_value  # tests/postproc/conftest.py
 
 sys.path.insert(0, os.path.join(SOURCE, "postproc"))
 import morphogen_h5 as mh  # noqa: E402
@@ -34,20 +33,10 @@ STEPS, EVERY = 20, 10
 
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
-    base = tmp_path_factory.mktemp("h5runs")
-    out = {}
-    for key, (n, L, extra, ranks) in RUNS.items():
-        d = base / key
-        args = ["-grid_n", ",".join(map(str, n)), "-grid_L", ",".join(map(str, L)),
-                "-steps", str(STEPS), "-snapshot_every", str(EVERY), "-checkpoint_every", str(EVERY),
-                "-output_dir", str(d)] + extra
-        proc = run(args, cwd=base, ranks=ranks)
-        assert proc.returncode == 0, f"{key}: {proc.stdout}\n{proc.stderr}"
-        name = extra[extra.index("-output_name") + 1] if "-output_name" in extra else "morphogen"
-        dt = float(extra[extra.index("-dt") + 1])
-        h = [L[a] / n[a] for a in range(len(n))]
-        precision = "float64" if "float64" in extra else "float32"
-        out[key] = dict(dir=d, name=name, n=n, h=h, dt=dt, ranks=ranks, precision=precision)
+    out = launch_runs(tmp_path_factory.mktemp("h5runs"), RUNS, STEPS, EVERY, ["-checkpoint_every", str(EVERY)])
+    for r in out.values():
+        r["dt"] = float(option_value(r["extra"], "-dt"))
+        r["precision"] = "float64" if "float64" in r["extra"] else "float32"
     return out
 
 

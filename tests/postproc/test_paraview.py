@@ -24,8 +24,7 @@ import sys
 import numpy as np
 import pytest
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "app"))
-from conftest import SOURCE, run  # noqa: E402
+from conftest import SOURCE, launch_runs  # tests/postproc/conftest.py
 
 sys.path.insert(0, os.path.join(SOURCE, "postproc"))
 import morphogen_h5 as mh  # noqa: E402  (h5py, in this process only)
@@ -142,25 +141,17 @@ def pvpython_cmd():
 
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
-    base = tmp_path_factory.mktemp("pvruns")
-    out = {}
-    for key, (n, L, extra, ranks) in RUNS.items():
-        d = base / key
-        args = ["-grid_n", ",".join(map(str, n)), "-grid_L", ",".join(map(str, L)),
-                "-steps", str(STEPS), "-snapshot_every", str(EVERY), "-output_dir", str(d)] + extra
-        proc = run(args, cwd=base, ranks=ranks)
-        assert proc.returncode == 0, f"{key}: {proc.stdout}\n{proc.stderr}"
-        name = extra[extra.index("-output_name") + 1] if "-output_name" in extra else "morphogen"
-        h = [L[a] / n[a] for a in range(len(n))]
+    out = launch_runs(tmp_path_factory.mktemp("pvruns"), RUNS, STEPS, EVERY)
+    for r in out.values():
+        d, n, h = r["dir"], r["n"], r["h"]
         if len(n) == 2:
             extent, origin, spacing = [0, n[0] - 1, 0, n[1] - 1, 0, 0], [h[0] / 2, h[1] / 2, 0.0], h + [h[0]]
         else:
             extent, origin, spacing = [0, n[0] - 1, 0, n[1] - 1, 0, n[2] - 1], [x / 2 for x in h], h
         series = mh.read_series(str(d))
-        out[key] = dict(dir=d, name=name, xmf=d / f"{name}.xmf", extent=extent, origin=origin,
-                        spacing=spacing, dim=len(n), series=series,
-                        vtk_type="double" if "float64" in extra else "float",
-                        snaps=[mh.read_snapshot(p) for _, p in series])
+        r.update(xmf=d / f"{r['name']}.xmf", extent=extent, origin=origin, spacing=spacing, dim=len(n),
+                 series=series, vtk_type="double" if "float64" in r["extra"] else "float",
+                 snaps=[mh.read_snapshot(p) for _, p in series])
     return out
 
 
