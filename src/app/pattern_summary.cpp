@@ -82,17 +82,23 @@ void FieldSampler::take(Simulation& sim) {
     double* a4 = &acc[4 * s];
     const PetscScalar* a;
     MG_PETSC(VecGetArrayRead(sim.state()[s], &a));
+    double sum = 0, sq = 0, change = 0;
     for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
-      for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j)
-        for (PetscInt i = ob.s[0]; i < ob.s[0] + ob.m[0]; ++i) {
-          const double v = a[g.local_index(i, j, k)];
-          double& p = prev[static_cast<size_t>(g.owned_index(i, j, k))];
-          a4[0] += v;
-          a4[1] += v * v;
-          a4[2] += first ? 0.0 : (v - p) * (v - p);
-          p = v;
-          if (i == ci && j == cj && k == ck) a4[3] = v;
+      for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j) {
+        const double* row = a + g.local_index(ob.s[0], j, k);
+        double* prow = prev.data() + g.owned_index(ob.s[0], j, k);
+        for (PetscInt i = 0; i < ob.m[0]; ++i) {
+          const double v = row[i], d = v - prow[i];
+          sum += v;
+          sq += v * v;
+          change += d * d;
+          prow[i] = v;
         }
+      }
+    a4[0] = sum;
+    a4[1] = sq;
+    a4[2] = first ? 0.0 : change;
+    if (ob.contains(ci, cj, ck)) a4[3] = a[g.local_index(ci, cj, ck)];
     MG_PETSC(VecRestoreArrayRead(sim.state()[s], &a));
   }
   MPI_Allreduce(MPI_IN_PLACE, acc.data(), static_cast<int>(acc.size()), MPI_DOUBLE, MPI_SUM,
