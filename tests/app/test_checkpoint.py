@@ -236,3 +236,21 @@ def test_full_disk_exits_4_and_keeps_previous_checkpoint(tmp_path):
         assert "step 10" in r.stdout
     finally:
         subprocess.run(["umount", str(full)])
+
+
+def test_time_and_walltime_triggers(tmp_path):
+    # every T of simulated time: dt 0.5, T 5 -> steps 10, 20, 30; keep 10
+    ok(run(BASE + ["-steps", "30", "-checkpoint_every_time", "5", "-checkpoint_keep", "10",
+                   "-checkpoint_final", "false", "-snapshot_every_time", "7.5", "-output_dir",
+                   "t"], tmp_path))
+    steps = sorted(attrs(p)["step"] for p in (tmp_path / "t").glob("checkpoint_*.vtkhdf"))
+    assert steps == [10, 20, 30]
+    series = json.loads((tmp_path / "t/morphogen.vtkhdf.series").read_text())
+    assert [f["time"] for f in series["files"]] == [0.0, 7.5, 15.0]
+    # every W minutes of wall time (0.3 s) on a run of a few seconds; keep the newest 3
+    r = ok(run(["-grid_n", "192,192", "-png_every", "0", "-steps", "150000",
+                "-checkpoint_every_walltime", "0.005", "-checkpoint_keep", "3",
+                "-checkpoint_final", "false", "-output_dir", "w"], tmp_path, 2))
+    kept = list((tmp_path / "w").glob("checkpoint_*.vtkhdf"))
+    assert len(kept) == 3, r.stdout[-500:]
+    assert all(attrs(p)["complete"] == 1 for p in kept)
