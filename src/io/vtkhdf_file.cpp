@@ -299,6 +299,7 @@ PetscErrorCode VtkHdfIO::write_impl(const std::string& path, const std::vector<s
   PetscFunctionBeginUser;
   PetscViewer v;
   PetscCall(PetscViewerHDF5Open(grid_.comm(), path.c_str(), FILE_MODE_WRITE, &v));
+  PetscCall(PetscViewerHDF5SetCollective(v, PETSC_TRUE)); // MPI-IO collective transfers
   PetscCall(PetscViewerHDF5SetSPOutput(v, single_precision ? PETSC_TRUE : PETSC_FALSE));
   PetscCall(PetscViewerHDF5PushGroup(v, "/VTKHDF/PointData"));
   for (size_t s = 0; s < fields.size(); ++s) {
@@ -346,6 +347,7 @@ PetscErrorCode VtkHdfIO::read_impl(const std::string& path, const std::vector<st
   PetscFunctionBeginUser;
   PetscViewer v;
   PetscCall(PetscViewerHDF5Open(grid_.comm(), path.c_str(), FILE_MODE_READ, &v));
+  PetscCall(PetscViewerHDF5SetCollective(v, PETSC_TRUE));
   PetscCall(PetscViewerHDF5PushGroup(v, "/VTKHDF/PointData"));
   for (size_t s = 0; s < fields.size(); ++s) {
     PetscCall(PetscObjectSetName(reinterpret_cast<PetscObject>(io_.get()), names[s].c_str()));
