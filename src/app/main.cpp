@@ -83,7 +83,7 @@ void print_header(MPI_Comm comm, const Simulation& sim, int level, int levels) {
               size == 1 ? "" : "s", sim.output().dir.c_str());
 }
 
-int run(int* argc, char*** argv) {
+int run(int* argc, char*** argv, double wall_start) {
   MPI_Comm comm = PETSC_COMM_WORLD;
   const std::string base_dir = load_deck(argc, argv);
   Options opt(comm);
@@ -123,8 +123,18 @@ int run(int* argc, char*** argv) {
     throw UserError("-restart " + rp->path + ": written on grid-sequencing level " +
                     std::to_string(start + 1) + ", but -sequence_levels is " +
                     std::to_string(levels));
+  if (rp) { // refuse a mismatched checkpoint before anything is written
+    PetscInt end_at_start = 0;
+    for (int l = 0; l <= start; ++l)
+      end_at_start += l + 1 < levels ? level_steps[l] : first->steps();
+    if (rp->step > end_at_start)
+      throw UserError("-restart " + rp->path + ": the checkpoint is at step " +
+                      std::to_string(rp->step) + ", past the end of the run (step " +
+                      std::to_string(end_at_start) + "); raise -steps");
+    if (start == 0) check_restart_grid(*first, *rp);
+  }
   prepare_output(comm, opt, *first);
-  RunOutput output(comm, opt);
+  RunOutput output(comm, opt, wall_start);
   std::unique_ptr<Simulation> prev;
   PetscInt end = 0; // global step index at which the current level ends
   for (int l = 0; l < levels; ++l) {
@@ -171,10 +181,11 @@ int main(int argc, char** argv) {
   PetscCall(PetscInitialize(&argc, &argv, nullptr,
                             "morphogen [DECK.yaml] [-option value ...]; -help lists options\n"));
   install_stop_signal_handlers();
+  const double wall_start = MPI_Wtime(); // -max_walltime counts from here
   int rc = 0;
   try {
     rc = argc > 1 && std::string(argv[1]) == "sweep" ? sweep::run_sweep(&argc, &argv)
-                                                     : run(&argc, &argv);
+                                                     : run(&argc, &argv, wall_start);
   } catch (const UserError& e) {
     PetscFPrintf(PETSC_COMM_WORLD, PETSC_STDERR, "morphogen: error: %s\n", e.what());
     rc = 1;

@@ -11,12 +11,18 @@ namespace morphogen {
 
 namespace {
 
-// "" if usable, else why not.
-std::string check_checkpoint(const io::ImageInfo& info, const ModelEntry& model) {
+// "" if the file is a complete checkpoint, else why not.
+std::string check_complete(const io::ImageInfo& info) {
   const auto& a = info.attributes;
   const long long* complete = a.integer("complete");
   if (!complete || *complete != 1 || !a.real("time") || !a.integer("step") || !a.integer("level"))
     return "no complete /morphogen restart record (a snapshot, or an interrupted write)";
+  return {};
+}
+
+// "" if a complete checkpoint fits this run's model, else why not.
+std::string check_model(const io::ImageInfo& info, const ModelEntry& model) {
+  const auto& a = info.attributes;
   const std::string* m = a.string("model");
   if (!m || *m != model.name)
     return "written by model " + (m ? *m : std::string("?")) + ", this run uses " + model.name;
@@ -49,8 +55,12 @@ std::optional<RestartPoint> locate_restart(MPI_Comm comm, const std::string& spe
     if (spec == "latest") {
       for (const auto& [step, p] : io::list_checkpoints(dir)) {
         auto info = io::inspect_vtkhdf(p, why);
-        if (info) why = check_checkpoint(*info, model);
+        if (info) why = check_complete(*info);
         if (info && why.empty()) {
+          // A complete checkpoint of another model is a mistake, not a reason to start over
+          // (which would retire the whole chain).
+          const std::string wrong = check_model(*info, model);
+          if (!wrong.empty()) err = "-restart latest: " + p + ": " + wrong;
           path = p;
           json = info->to_json();
           break;
@@ -58,13 +68,14 @@ std::optional<RestartPoint> locate_restart(MPI_Comm comm, const std::string& spe
         std::fprintf(stderr, "morphogen: warning: -restart latest: skipping %s: %s\n", p.c_str(),
                      why.c_str());
       }
-      if (path.empty())
+      if (path.empty() && err.empty())
         std::printf("note: -restart latest: no usable checkpoint in %s/, starting from the initial "
                     "condition\n",
                     dir.c_str());
     } else {
       auto info = io::inspect_vtkhdf(spec, why);
-      if (info) why = check_checkpoint(*info, model);
+      if (info) why = check_complete(*info);
+      if (info && why.empty()) why = check_model(*info, model);
       if (!info || !why.empty())
         err = "-restart " + spec + ": not a usable checkpoint: " + why +
               " (allowed: a checkpoint_*.vtkhdf file or 'latest')";
@@ -86,7 +97,7 @@ std::optional<RestartPoint> locate_restart(MPI_Comm comm, const std::string& spe
   return rp;
 }
 
-void restore(Simulation& sim, const RestartPoint& rp) {
+void check_restart_grid(const Simulation& sim, const RestartPoint& rp) {
   const auto& g = sim.grid().spec();
   for (int d = 0; d < 3; ++d) {
     const long long n = d < g.dim ? g.n[d] : 1;
@@ -100,6 +111,10 @@ void restore(Simulation& sim, const RestartPoint& rp) {
           (sim.level() > 0 || rp.level > 0 ? " (sequencing level " + std::to_string(rp.level) + ")"
                                            : std::string()));
   }
+}
+
+void restore(Simulation& sim, const RestartPoint& rp) {
+  check_restart_grid(sim, rp);
   std::vector<Vec> fields;
   for (auto& v : sim.state())
     fields.push_back(v);

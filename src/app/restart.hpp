@@ -28,6 +28,9 @@ struct RestartPoint {
 std::optional<RestartPoint> locate_restart(MPI_Comm comm, const std::string& spec,
                                            const std::string& dir, const ModelEntry& model);
 
+// UserError (identical on every rank) if the checkpoint's extents or spacing differ from sim's.
+void check_restart_grid(const Simulation& sim, const RestartPoint& rp);
+
 // Collective. Checks the checkpoint against sim's grid (UserError if it does not match), loads
 // the fields and sets the clock.
 void restore(Simulation& sim, const RestartPoint& rp);

@@ -45,10 +45,10 @@ std::string step_file(const std::string& name, long long step) {
 
 } // namespace
 
-RunOutput::RunOutput(MPI_Comm comm, const Options& opt) : comm_(comm), opt_(opt) {
+RunOutput::RunOutput(MPI_Comm comm, const Options& opt, double wall_start)
+    : comm_(comm), opt_(opt), wall_start_(wall_start) {
   MPI_Comm_rank(comm, &rank_);
   MPI_Comm_size(comm, &size_);
-  wall_start_ = MPI_Wtime();
 }
 
 void RunOutput::begin(Simulation& sim, long long restart_step, PetscInt end_step) {
@@ -60,7 +60,7 @@ void RunOutput::begin(Simulation& sim, long long restart_step, PetscInt end_step
     if (rank_ == 0) {
       const auto retired = io::retire_checkpoints_after(out.dir, restart_step);
       for (const auto& p : retired)
-        std::printf("note: %s is %s: renamed to %s.stale\n", p.c_str(),
+        std::printf("note: %s is %s: renamed to %s.stale*\n", p.c_str(),
                     restart_step < 0 ? "from an earlier run" : "newer than the restart point",
                     p.c_str());
       if (restart_step >= 0) series_->load_existing(restart_step);
@@ -96,8 +96,13 @@ int RunOutput::poll_stop_flags(const Simulation& sim) {
     const double wall = now - wall_start_;
     if (out.checkpoint_every_walltime > 0 && wall >= next_wall_checkpoint_)
       flags |= kWallCheckpoint;
-    // Stop while there is time for two more steps and a checkpoint write.
-    const double margin = 2 * step_seconds_ + 2 * last_write_seconds_ + 1.0;
+    // Stop while there is time for two more steps and a checkpoint write (before the first
+    // write, estimated at 100 MB/s for the run's float64 fields).
+    const double write = last_write_seconds_ > 0
+                             ? last_write_seconds_
+                             : 8.0 * static_cast<double>(sim.grid().global_cells()) *
+                                   static_cast<double>(sim.species().size()) / 1e8;
+    const double margin = 2 * step_seconds_ + 2 * write + 1.0;
     if (out.max_walltime > 0 && wall + margin >= out.max_walltime * 60.0) flags |= kWallBudget;
   }
   MPI_Allreduce(MPI_IN_PLACE, &flags, 1, MPI_INT, MPI_BOR, comm_);
@@ -156,7 +161,8 @@ void RunOutput::finish(Simulation& sim) {
                       {"species", species},
                       {"stability", stability}};
   const std::string path = sim.output().dir + "/summary.json";
-  const std::string err = io::write_file_atomically(path, j.dump(1) + "\n");
+  const std::string err = io::write_file_atomically(
+      path, j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   if (!err.empty()) write_failed("summary", path, err);
   std::string line;
   for (const auto& [name, c] : species.items())

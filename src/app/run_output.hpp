@@ -24,7 +24,8 @@ constexpr int kExitWriteFailed = 4;
 
 class RunOutput {
 public:
-  RunOutput(MPI_Comm comm, const Options& opt);
+  // wall_start: MPI_Wtime() when the program started (for -max_walltime).
+  RunOutput(MPI_Comm comm, const Options& opt, double wall_start);
 
   // Start writing for a (new level's) simulation. restart_step < 0: a fresh run (checkpoints
   // of an earlier run in the directory are retired, the series starts empty); otherwise the run

@@ -48,7 +48,10 @@ std::vector<std::string> retire_checkpoints_after(const std::string& dir, long l
   for (const auto& [s, path] : list_checkpoints(dir)) {
     if (s <= step) continue;
     std::error_code ec;
-    fs::rename(path, path + ".stale", ec);
+    std::string stale = path + ".stale";
+    for (int k = 1; fs::exists(stale, ec); ++k) // never overwrite an earlier stale file
+      stale = path + ".stale" + std::to_string(k);
+    fs::rename(path, stale, ec);
     if (!ec) renamed.push_back(path);
   }
   return renamed;

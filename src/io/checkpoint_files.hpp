@@ -19,7 +19,8 @@ std::vector<std::pair<long long, std::string>> list_checkpoints(const std::strin
 std::vector<std::string> prune_checkpoints(const std::string& dir, int keep);
 
 // Renames checkpoints with step > `step` (an abandoned future after a restart from an older
-// one) to <path>.stale, so `latest` never picks them. Returns the paths renamed.
+// one) to <path>.stale (.stale1, ... if that exists), so `latest` never picks them. Returns the
+// paths renamed.
 std::vector<std::string> retire_checkpoints_after(const std::string& dir, long long step);
 
 } // namespace morphogen::io

@@ -26,7 +26,8 @@ long long step_of(const std::string& file, const std::string& name) {
       file.compare(file.size() - suf.size(), suf.size(), suf) != 0)
     return -1;
   const std::string digits = file.substr(pre.size(), file.size() - pre.size() - suf.size());
-  if (digits.empty() || !std::all_of(digits.begin(), digits.end(), ::isdigit)) return -1;
+  if (digits.empty() || digits.size() > 18 || !std::all_of(digits.begin(), digits.end(), ::isdigit))
+    return -1;
   return std::stoll(digits);
 }
 
@@ -120,7 +121,8 @@ std::string SeriesIndex::write() const {
   for (const auto& e : entries_)
     files.push_back({{"name", e.file}, {"time", e.time}});
   const nlohmann::json series = {{"file-series-version", "1.0"}, {"files", files}};
-  std::string err = write_file_atomically(series_path(), series.dump(2) + "\n");
+  std::string err = write_file_atomically(
+      series_path(), series.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   if (!err.empty()) return err;
 
   std::ostringstream x;

@@ -179,7 +179,7 @@ std::string ImageInfo::to_json() const {
   j["reals"] = attributes.reals;
   j["ints"] = attributes.ints;
   j["strings"] = attributes.strings;
-  return j.dump();
+  return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 ImageInfo ImageInfo::from_json(const std::string& text) {

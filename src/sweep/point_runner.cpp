@@ -19,8 +19,10 @@ std::string point_file(long long p, const char* ext) {
   return buf;
 }
 
-nlohmann::json run_point(const SweepSpec& spec, long long p, const SweepSettings& set, WorkQueue& q,
-                         bool& interrupted) {
+namespace {
+
+nlohmann::json run_point_impl(const SweepSpec& spec, long long p, const SweepSettings& set,
+                              WorkQueue& q, bool& interrupted) {
   MPI_Comm comm = q.group();
   interrupted = false;
   const double t0 = MPI_Wtime();
@@ -86,6 +88,11 @@ nlohmann::json run_point(const SweepSpec& spec, long long p, const SweepSettings
   if (rank != 0) return {};
   std::error_code ec;
   std::filesystem::rename(path + ".tmp", path, ec);
+  if (ec) {
+    std::fprintf(stderr, "morphogen: error: renaming %s.tmp failed (%s)\n", path.c_str(),
+                 ec.message().c_str());
+    MPI_Abort(MPI_COMM_WORLD, 4);
+  }
 
   nlohmann::json r;
   r["index"] = p;
@@ -112,6 +119,32 @@ nlohmann::json run_point(const SweepSpec& spec, long long p, const SweepSettings
   r["runtime_s"] = MPI_Wtime() - t0;
   r["series"] = samples_json(sampler.samples(sm));
   return r;
+}
+
+} // namespace
+
+nlohmann::json run_point(const SweepSpec& spec, long long p, const SweepSettings& set, WorkQueue& q,
+                         bool& interrupted) {
+  const double t0 = MPI_Wtime();
+  try {
+    return run_point_impl(spec, p, set, q, interrupted);
+  } catch (const UserError& e) {
+    // A combination of axis values that cannot run (validated one axis at a time, so possible):
+    // the error is collective on the group; record it and go on with the other points.
+    int rank = 0;
+    MPI_Comm_rank(q.group(), &rank);
+    if (rank != 0) return {};
+    nlohmann::json params = nlohmann::json::object();
+    const auto idx = spec.indices(p);
+    for (size_t ax = 0; ax < spec.axes.size(); ++ax)
+      params[spec.axes[ax].option] = spec.axes[ax].numbers[static_cast<size_t>(idx[ax])];
+    std::fprintf(stderr, "morphogen: warning: sweep point %lld: %s\n", p, e.what());
+    return {{"index", p},
+            {"params", params},
+            {"class", "error"},
+            {"reason", e.what()},
+            {"runtime_s", MPI_Wtime() - t0}};
+  }
 }
 
 } // namespace morphogen::sweep

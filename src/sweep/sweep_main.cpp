@@ -12,6 +12,7 @@
 #include "sweep/work_queue.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -119,16 +120,38 @@ std::string validate(const Setup& s, std::string& dir) {
   return yaml;
 }
 
-std::vector<long long> finished_points(const std::string& dir, long long n) {
+// Points with a record in dir/points. A record whose parameters differ from this sweep's at
+// its index (the axes changed since) is an error; an unreadable record or one of class
+// "error" is not finished (it runs again).
+std::vector<long long> finished_points(const std::string& dir, const SweepSpec& spec,
+                                       std::string& err) {
   std::vector<long long> done;
+  const long long n = spec.points();
   std::error_code ec;
   for (fs::directory_iterator it(dir + "/points", ec), end; !ec && it != end; it.increment(ec)) {
     const std::string f = it->path().filename().string();
     long long p = -1;
     char tail[8] = "";
-    if (std::sscanf(f.c_str(), "point_%lld.%7s", &p, tail) == 2 && std::string(tail) == "json" &&
-        p >= 0 && p < n && f == point_file(p, "json"))
-      done.push_back(p);
+    if (std::sscanf(f.c_str(), "point_%lld.%7s", &p, tail) != 2 || std::string(tail) != "json" ||
+        p < 0 || p >= n || f != point_file(p, "json"))
+      continue;
+    std::ifstream in(it->path());
+    const nlohmann::json r = nlohmann::json::parse(in, nullptr, false);
+    if (r.is_discarded() || !r.contains("class") || !r.contains("params") || r["class"] == "error")
+      continue;
+    const auto idx = spec.indices(p);
+    for (size_t a = 0; a < spec.axes.size() && err.empty(); ++a) {
+      const auto& ax = spec.axes[a];
+      const double want = ax.numbers[static_cast<size_t>(idx[a])];
+      const auto& got = r["params"].contains(ax.option) ? r["params"][ax.option] : nlohmann::json();
+      if (!got.is_number() ||
+          std::fabs(got.get<double>() - want) > 1e-12 * std::max(1.0, std::fabs(want)))
+        err = "-output_dir " + dir + ": points/" + f + " was computed with " + ax.option + " = " +
+              (got.is_number() ? format_double(got.get<double>()) : std::string("(none)")) +
+              ", this sweep has " + format_double(want) +
+              " at that point (the axes changed); use another -output_dir";
+    }
+    done.push_back(p);
   }
   return done;
 }
@@ -158,30 +181,28 @@ int run_sweep(int* argc, char*** argv) {
   std::string err;
   std::vector<long long> todo;
   if (rank == 0) {
+    std::vector<long long> done = finished_points(dir, s.spec, err);
     std::error_code ec;
-    fs::create_directories(dir + "/points", ec);
+    if (err.empty()) fs::create_directories(dir + "/points", ec);
     if (ec)
       err = "-output_dir " + dir + ": cannot create " + dir + "/points (" + ec.message() + ")";
-    else
-      err = io::write_file_atomically(
+    if (err.empty()) {
+      const std::string werr = io::write_file_atomically(
           dir + "/options_used.yaml",
           "# Options of this sweep (morphogen " MORPHOGEN_VERSION ")\n" + sopt.to_yaml("") + yaml);
-    if (!err.empty()) err = "-output_dir " + dir + ": " + err;
-    const auto done = finished_points(dir, npoints);
+      if (!werr.empty()) err = "-output_dir " + dir + ": " + werr;
+    }
     for (long long p = s.chunk; p < npoints; p += s.chunks)
       if (std::find(done.begin(), done.end(), p) == done.end()) todo.push_back(p);
-    std::printf(
-        "sweep: %lld points (%s), chunk %lld/%lld: %zu to run, %zu already done -> %s/\n", npoints,
-        [&] {
-          std::string a;
-          for (const auto& ax : s.spec.axes)
-            a +=
-                (a.empty() ? "" : " x ") + ax.option + "[" + std::to_string(ax.values.size()) + "]";
-          return a;
-        }()
-            .c_str(),
-        s.chunk, s.chunks, todo.size(), done.size(), dir.c_str());
-    std::fflush(stdout);
+    if (err.empty()) {
+      std::string axes;
+      for (const auto& ax : s.spec.axes)
+        axes +=
+            (axes.empty() ? "" : " x ") + ax.option + "[" + std::to_string(ax.values.size()) + "]";
+      std::printf("sweep: %lld points (%s), chunk %lld/%lld: %zu to run, %zu already done -> %s/\n",
+                  npoints, axes.c_str(), s.chunk, s.chunks, todo.size(), done.size(), dir.c_str());
+      std::fflush(stdout);
+    }
   }
   throw_if_any(world, err);
   long long ntodo = static_cast<long long>(todo.size());
@@ -201,28 +222,26 @@ int run_sweep(int* argc, char*** argv) {
     const nlohmann::json r = run_point(s.spec, p, s.set, q, interrupted);
     last_seconds = MPI_Wtime() - tp;
     if (interrupted) {
-      // Stop handing out points; wait for the others to finish theirs.
-      while (q.next() >= 0) {
-      }
+      q.next(-1.0); // tells rank 0 to stop handing out points
       break;
     }
     if (q.leader()) {
-      const std::string jerr =
-          io::write_file_atomically(dir + "/points/" + point_file(p, "json"), r.dump(1) + "\n");
+      const std::string jerr = io::write_file_atomically(
+          dir + "/points/" + point_file(p, "json"),
+          r.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
       if (!jerr.empty()) {
         std::fprintf(stderr, "morphogen: error: %s\n", jerr.c_str());
         MPI_Abort(world, 4);
       }
-      cell_updates += r["cells"].get<double>() * r["steps"].get<double>();
+      if (r.contains("cells")) cell_updates += r["cells"].get<double>() * r["steps"].get<double>();
       ++ran;
-      std::string params;
+      std::string params, wavelength = "-";
       for (const auto& [k, v] : r["params"].items())
         params += (params.empty() ? "" : " ") + k + "=" + format_double(v.get<double>());
+      if (r.contains("metrics") && r["metrics"]["wavelength"].is_number())
+        wavelength = format_double(r["metrics"]["wavelength"].get<double>());
       std::printf("point %lld [%s]: %s (wavelength %s), %.2f s, group %d\n", p, params.c_str(),
-                  r["class"].get<std::string>().c_str(),
-                  r["metrics"]["wavelength"].is_null()
-                      ? "-"
-                      : std::to_string(r["metrics"]["wavelength"].get<double>()).c_str(),
+                  r["class"].get<std::string>().c_str(), wavelength.c_str(),
                   r["runtime_s"].get<double>(), q.group_index());
       std::fflush(stdout);
     }
@@ -236,7 +255,7 @@ int run_sweep(int* argc, char*** argv) {
   int cut = q.cut_by_deadline();
   MPI_Bcast(&cut, 1, MPI_INT, 0, world);
   if (rank == 0) {
-    const std::string terr = write_sweep_table(dir, s.spec, yaml);
+    const std::string terr = write_sweep_table(dir, s.spec, yaml, s.set.base_dir);
     if (!terr.empty()) {
       std::fprintf(stderr, "morphogen: error: %s\n", terr.c_str());
       MPI_Abort(world, 4);

@@ -10,8 +10,11 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <fcntl.h>
 #include <fstream>
 #include <map>
+#include <sys/file.h>
+#include <unistd.h>
 
 namespace morphogen::sweep {
 
@@ -37,12 +40,12 @@ std::vector<double> refined(const std::vector<double>& v, int refine) {
 
 // Linear stability over a refined grid of the axes (empty when an axis is not a model
 // parameter or diffusion coefficient, or a parameter varies in space).
-nlohmann::json stability_map(const SweepSpec& spec) {
+nlohmann::json stability_map(const SweepSpec& spec, const std::string& base_dir) {
   // The base configuration: the options database holds the deck plus the last point's values.
   Options opt(PETSC_COMM_SELF);
   for (const auto& a : spec.axes)
     MG_PETSC(PetscOptionsSetValue(nullptr, ("-" + a.option).c_str(), a.values[0].c_str()));
-  Simulation sim(PETSC_COMM_SELF, opt, "");
+  Simulation sim(PETSC_COMM_SELF, opt, base_dir);
   if (sim.params().any_field()) return {};
   const ModelEntry& m = sim.model();
   std::vector<double> params = sim.params().scalar, D = sim.diffusion();
@@ -103,7 +106,17 @@ nlohmann::json stability_map(const SweepSpec& spec) {
 } // namespace
 
 std::string write_sweep_table(const std::string& dir, const SweepSpec& spec,
-                              const std::string& base_options) {
+                              const std::string& base_options, const std::string& base_dir) {
+  nlohmann::json map;
+  try {
+    map = stability_map(spec, base_dir);
+  } catch (const std::exception& e) {
+    map = {{"error", e.what()}};
+  }
+  // Chunks sharing the directory: scan and write under a lock, so the newest scan wins and
+  // sweep.csv and sweep.json come from the same scan.
+  const int lock = open((dir + "/.sweep.lock").c_str(), O_CREAT | O_RDWR, 0644);
+  if (lock >= 0) flock(lock, LOCK_EX);
   std::vector<std::string> names;
   nlohmann::json axes = nlohmann::json::array();
   for (const auto& a : spec.axes) {
@@ -126,13 +139,16 @@ std::string write_sweep_table(const std::string& dir, const SweepSpec& spec,
   nlohmann::json j = {
       {"axes", axes},       {"points", spec.points()},      {"finished", records.size()},
       {"classes", classes}, {"base_options", base_options}, {"records", records}};
-  try {
-    j["stability_map"] = stability_map(spec);
-  } catch (const std::exception& e) {
-    j["stability_map"] = {{"error", e.what()}};
-  }
+  j["stability_map"] = std::move(map);
   std::string err = io::write_file_atomically(dir + "/sweep.csv", csv);
-  if (err.empty()) err = io::write_file_atomically(dir + "/sweep.json", j.dump(1) + "\n");
+  if (err.empty())
+    err = io::write_file_atomically(
+        dir + "/sweep.json",
+        j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+  if (lock >= 0) {
+    flock(lock, LOCK_UN);
+    close(lock);
+  }
   return err;
 }
 

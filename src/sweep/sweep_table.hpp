@@ -16,8 +16,10 @@
 
 namespace morphogen::sweep {
 
-// Returns "" or the error. base_options: the first point's options as YAML (for the record).
+// Returns "" or the error. base_options: the first point's options as YAML (for the record);
+// base_dir: the deck's directory (relative file names in values). Chunks writing at the same
+// time serialise on dir/.sweep.lock (flock).
 std::string write_sweep_table(const std::string& dir, const SweepSpec& spec,
-                              const std::string& base_options);
+                              const std::string& base_options, const std::string& base_dir);
 
 } // namespace morphogen::sweep

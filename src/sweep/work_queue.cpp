@@ -29,6 +29,7 @@ WorkQueue::~WorkQueue() {
 }
 
 long long WorkQueue::take(double seconds) {
+  if (seconds < 0) cursor_ = todo_.size(); // a group was stopped by a signal: stop everyone
   longest_ = std::max(longest_, seconds);
   if (cursor_ < todo_.size() && deadline_ > 0 && MPI_Wtime() + 1.5 * longest_ > deadline_) {
     cut_ = true;

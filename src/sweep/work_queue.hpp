@@ -28,7 +28,8 @@ public:
   bool leader() const { return group_rank_ == 0; }
 
   // Collective on the group: the next point for this group, or -1 when there is none left.
-  // last_seconds: the run time of the group's previous point (0 for none).
+  // last_seconds: the run time of the group's previous point (0 for none); negative: the group
+  // was interrupted, and no further point is handed out to anyone.
   long long next(double last_seconds = 0);
   // No point is handed out once MPI_Wtime() + 1.5 x the longest point time reported so far
   // would pass `deadline` (world rank 0's clock). Returns whether that cut any point.

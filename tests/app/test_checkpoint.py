@@ -254,3 +254,16 @@ def test_time_and_walltime_triggers(tmp_path):
     kept = list((tmp_path / "w").glob("checkpoint_*.vtkhdf"))
     assert len(kept) == 3, r.stdout[-500:]
     assert all(attrs(p)["complete"] == 1 for p in kept)
+
+
+def test_mismatched_restart_is_refused_before_writing(tmp_path):
+    ok(run(BASE + ["-steps", "20", "-output_dir", "o"], tmp_path))
+    before = (tmp_path / "o/options_used.yaml").read_text()
+    r = run(["-grid_n", "40,40", "-steps", "30", "-output_dir", "o", "-restart", "latest"],
+            tmp_path)
+    assert r.returncode == 1 and "does not match this run's -grid_n" in error_line(r)
+    r = run(BASE + ["-model", "gray_scott", "-steps", "30", "-output_dir", "o", "-restart",
+                    "latest"], tmp_path, 2)
+    assert r.returncode == 1 and "written by model turing" in error_line(r)
+    assert (tmp_path / "o/options_used.yaml").read_text() == before
+    assert (tmp_path / "o/checkpoint_0000020.vtkhdf").exists()  # not retired

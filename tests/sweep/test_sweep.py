@@ -132,3 +132,27 @@ def test_bad_sweep_input(tmp_path, args, needle):
     lines = [l for l in r.stderr.splitlines() if l.startswith("morphogen: error:")]
     assert lines and needle in lines[0], r.stderr
     assert not (tmp_path / "s").exists()
+
+
+def test_point_that_cannot_run_is_recorded_and_rerun(tmp_path):
+    # each axis value is valid alone; dt 1.5 with D_b 0.25 exceeds the explicit bound
+    deck = tmp_path / "combo.yaml"
+    deck.write_text("model: turing\ngrid: {n: '16,16'}\nsteps: 20\noutput_dir: c\n"
+                    "sweep: {axes: 'dt,D_b', dt: '0.5,1.5', D_b: '0.1,0.25'}\n")
+    r = ok(run(["sweep", str(deck)], tmp_path, 2, timeout=120))
+    rec = {x["index"]: x for x in table(tmp_path / "c")["records"]}
+    assert rec[3]["class"] == "error" and "-dt 1.5" in rec[3]["reason"]
+    assert all(rec[i]["class"] != "error" for i in (0, 1, 2))
+    r = ok(run(["sweep", str(deck), "-force_dt"], tmp_path, 2, timeout=120))
+    assert "1 to run, 3 already done" in r.stdout  # the error point runs again
+    assert table(tmp_path / "c")["records"][3]["class"] != "error"
+
+
+def test_changed_axes_are_refused_on_resume(tmp_path):
+    base = ["sweep", DECK] + SMALL + ["-steps", "50", "-sweep_params_F", "0.03,0.04",
+                                      "-sweep_params_k", "0.06", "-output_dir", "s"]
+    ok(run(base, tmp_path))
+    before = (tmp_path / "s/options_used.yaml").read_text()
+    r = run(base[:-4] + ["-sweep_params_k", "0.065", "-output_dir", "s"], tmp_path)
+    assert r.returncode == 1 and "the axes changed" in r.stderr, r.stderr
+    assert (tmp_path / "s/options_used.yaml").read_text() == before
