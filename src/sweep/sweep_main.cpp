@@ -115,6 +115,7 @@ std::string validate(const Setup& s, std::string& dir) {
         opt.check_unused();
         dir = sim.output().dir;
         yaml = opt.to_yaml("");
+        if (opt.help_requested()) return yaml; // the options are listed once
       }
     }
   return yaml;
@@ -174,6 +175,7 @@ int run_sweep(int* argc, char*** argv) {
   Setup s = read_setup(sopt, base_dir);
   std::string dir;
   const std::string yaml = validate(s, dir);
+  if (sopt.help_requested()) return 0; // -help lists the options; it runs nothing
   s.set.dir = dir;
   const long long npoints = s.spec.points();
 
