@@ -1,7 +1,8 @@
 // Pattern metrics of one 2-D scalar field (pure functions on plain arrays: no PETSc, no MPI).
 //
 // Input: u[i + nx*j] (row-major, j the slow index, j = 0 the bottom row), nx x ny cells of
-// spacing hx, hy, each axis periodic or not. Definitions (all documented again in README.md, "Pattern classes"):
+// spacing hx, hy, each axis periodic or not. Definitions (all documented again in README.md,
+// "Pattern classes"):
 //
 // Statistics. min, max, mean, stddev (population). p5 / p95: the values at sorted positions
 // floor(0.05 (N-1)) and floor(0.95 (N-1)). contrast = (p95 - p5) / (|mean| + 1e-12);

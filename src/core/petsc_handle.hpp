@@ -60,9 +60,8 @@ namespace morphogen {
 // user input (an unparsable deck, a grid too small for the rank count). Returns PETSc's
 // message, or "" on success.
 // PETSc error handler that keeps the innermost error's message (ctx: std::string*).
-inline PetscErrorCode petsc_capture_error(MPI_Comm, int, const char*, const char*,
-                                          PetscErrorCode n, PetscErrorType, const char* mess,
-                                          void* ctx) {
+inline PetscErrorCode petsc_capture_error(MPI_Comm, int, const char*, const char*, PetscErrorCode n,
+                                          PetscErrorType, const char* mess, void* ctx) {
   auto* out = static_cast<std::string*>(ctx);
   if (out->empty() && mess) {
     *out = mess;

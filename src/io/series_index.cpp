@@ -1,5 +1,7 @@
 #include "io/series_index.hpp"
 
+#include "core/options.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -12,12 +14,6 @@
 namespace morphogen::io {
 
 namespace {
-
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
 
 // Step number of "<name>_<digits>.vtkhdf", or -1.
 long long step_of(const std::string& file, const std::string& name) {
@@ -37,15 +33,15 @@ std::string xmf_grid(const SeriesEntry& e) {
       std::to_string(n[2]) + " " + std::to_string(n[1]) + " " + std::to_string(n[0]);
   std::ostringstream x;
   x << "   <Grid Name=\"step_" << e.step << "\" GridType=\"Uniform\">\n"
-    << "    <Time Value=\"" << num(e.time) << "\"/>\n"
+    << "    <Time Value=\"" << format_double(e.time) << "\"/>\n"
     << "    <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"" << dims << "\"/>\n"
     << "    <Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n"
     << "     <DataItem Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" Format=\"XML\">"
-    << num(e.info.origin[2]) << " " << num(e.info.origin[1]) << " " << num(e.info.origin[0])
-    << "</DataItem>\n"
+    << format_double(e.info.origin[2]) << " " << format_double(e.info.origin[1]) << " "
+    << format_double(e.info.origin[0]) << "</DataItem>\n"
     << "     <DataItem Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" Format=\"XML\">"
-    << num(e.info.spacing[2]) << " " << num(e.info.spacing[1]) << " " << num(e.info.spacing[0])
-    << "</DataItem>\n"
+    << format_double(e.info.spacing[2]) << " " << format_double(e.info.spacing[1]) << " "
+    << format_double(e.info.spacing[0]) << "</DataItem>\n"
     << "    </Geometry>\n";
   for (const auto& a : e.info.arrays)
     x << "    <Attribute Name=\"" << a << "\" AttributeType=\"Scalar\" Center=\"Node\">\n"
