@@ -58,6 +58,16 @@ void RunOutput::begin(Simulation& sim, long long restart_step, PetscInt end_step
   if (!series_) {
     series_ = std::make_unique<io::SeriesIndex>(out.dir, out.name);
     if (rank_ == 0) {
+      // Temporary files of a killed earlier run: never complete, remove them.
+      std::error_code ec;
+      for (std::filesystem::directory_iterator it(out.dir, ec), end; !ec && it != end;
+           it.increment(ec)) {
+        const std::string f = it->path().filename().string();
+        if (f.find(".vtkhdf.tmp") != std::string::npos || f.find(".tmp.") != std::string::npos) {
+          std::error_code rm;
+          std::filesystem::remove(it->path(), rm);
+        }
+      }
       const auto retired = io::retire_checkpoints_after(out.dir, restart_step);
       for (const auto& p : retired)
         std::printf("note: %s is %s: renamed to %s.stale*\n", p.c_str(),
