@@ -52,6 +52,18 @@ struct Dispersion {
       A[i] = J[i];
     for (int s = 0; s < n; ++s)
       A[s * n + s] -= q * D[s];
+    return of(A);
+  }
+  // A = J - diag(qs): per-species symbols.
+  DispersionPoint at_species(const double* qs) const {
+    double A[kMaxSpecies * kMaxSpecies];
+    for (int i = 0; i < n * n; ++i)
+      A[i] = J[i];
+    for (int s = 0; s < n; ++s)
+      A[s * n + s] -= qs[s];
+    return of(A);
+  }
+  DispersionPoint of(const double* A) const {
     std::complex<double> ev[kMaxSpecies];
     DispersionPoint p{0, std::numeric_limits<double>::quiet_NaN(), 0};
     if (!eigenvalues(n, A, ev, general)) return p;
@@ -85,6 +97,81 @@ double q_of(const Stencil& st, const DiscreteGrid& g, const std::array<double, 3
     s += st.w[t] * std::cos(phase);
   }
   return -s;
+}
+
+// -symbol of a species operator; the same arithmetic as q_of (so D_s * stencil weights with D_s a
+// power of two give exactly D_s q).
+double op_q(const SpeciesOperator& op, int dim, const std::array<double, 3>& h,
+            const std::array<double, 3>& k) {
+  double s = 0;
+  for (size_t t = 0; t < op.w.size(); ++t) {
+    double phase = 0;
+    for (int d = 0; d < dim; ++d)
+      phase += k[d] * op.off[t][d] * h[d];
+    s += op.w[t] * std::cos(phase);
+  }
+  return -s;
+}
+
+// Relative tolerance of the symmetry and conservation checks of the operators.
+constexpr double kOpTol = 1e-12;
+
+// The weight of `op` at offset o (summed over repeated offsets).
+double weight_at(const SpeciesOperator& op, const std::array<int, 3>& o) {
+  double w = 0;
+  for (size_t t = 0; t < op.w.size(); ++t)
+    if (op.off[t] == o) w += op.w[t];
+  return w;
+}
+
+double max_abs_w(const SpeciesOperator& op) {
+  double m = 0;
+  for (double w : op.w)
+    m = std::max(m, std::abs(w));
+  return m;
+}
+
+// Throws unless `ops` are n valid operators for a grid of dimension dim (see the header).
+void check_operators(const std::vector<SpeciesOperator>& ops, int n, int dim) {
+  if (static_cast<int>(ops.size()) != n)
+    throw UserError("linear stability: " + std::to_string(ops.size()) + " species operators for " +
+                    std::to_string(n) + " species");
+  for (int s = 0; s < n; ++s) {
+    const SpeciesOperator& op = ops[s];
+    const std::string which = "linear stability: the operator of species " + std::to_string(s);
+    if (op.off.size() != op.w.size()) throw UserError(which + " has as many offsets as weights");
+    double sum = 0, sum_abs = 0;
+    for (size_t t = 0; t < op.w.size(); ++t) {
+      if (!std::isfinite(op.w[t])) throw UserError(which + " has a non-finite weight");
+      for (int d = dim; d < 3; ++d)
+        if (op.off[t][d] != 0)
+          throw UserError(which + " has an offset along axis " + std::to_string(d) + " of a " +
+                          std::to_string(dim) + "-D grid");
+      sum += op.w[t];
+      sum_abs += std::abs(op.w[t]);
+    }
+    if (std::abs(sum) > kOpTol * sum_abs)
+      throw UserError(which + " does not conserve mass (its weights do not sum to 0)");
+    const double wmax = max_abs_w(op);
+    for (const auto& o : op.off)
+      if (std::abs(weight_at(op, o) - weight_at(op, {-o[0], -o[1], -o[2]})) > kOpTol * wmax)
+        throw UserError(which + " is not symmetric (weight at -off differs from that at off)");
+  }
+}
+
+// Whether some operator differs from its reflection along some axis d < dim (then q(k) is not
+// even in each k_d separately, and the sign combinations of k's components must be scanned).
+bool needs_sign_scan(const std::vector<SpeciesOperator>& ops, int dim) {
+  for (const auto& op : ops) {
+    const double wmax = max_abs_w(op);
+    for (const auto& o : op.off)
+      for (int d = 0; d < dim; ++d) {
+        std::array<int, 3> r = o;
+        r[d] = -r[d];
+        if (std::abs(weight_at(op, o) - weight_at(op, r)) > kOpTol * wmax) return true;
+      }
+  }
+  return false;
 }
 
 // Golden-section search for the maximum of f on [a, b].
@@ -258,13 +345,42 @@ double laplacian_q(const DiscreteGrid* grid, const std::array<double, 3>& k) {
   return q_of(stencil_of(*grid), *grid, k);
 }
 
+double operator_q(const SpeciesOperator& op, const std::array<double, 3>& h,
+                  const std::array<double, 3>& k) {
+  if (op.off.size() != op.w.size())
+    throw UserError("linear stability: a species operator needs as many offsets as weights");
+  return op_q(op, 3, h, k);
+}
+
 DispersionPoint growth_at_q(const StabilityResult& r, double q) {
   if (!r.has_steady_state)
     throw UserError("linear stability: no steady state was analysed (growth_at_q)");
+  if (!r.operators.empty())
+    throw UserError("linear stability: growth_at_q needs one symbol for all species; with "
+                    "per-species operators use growth_at_k");
   const Dispersion disp{r.nspecies, r.jacobian.data(), r.diffusion.data(), r.dt,
                         r.general_eigensolver};
   DispersionPoint p = disp.at(q);
   p.k = std::sqrt(std::max(q, 0.0));
+  return p;
+}
+
+DispersionPoint growth_at_k(const StabilityResult& r, const std::array<double, 3>& k) {
+  if (!r.has_steady_state)
+    throw UserError("linear stability: no steady state was analysed (growth_at_k)");
+  const Dispersion disp{r.nspecies, r.jacobian.data(), r.diffusion.data(), r.dt,
+                        r.general_eigensolver};
+  DispersionPoint p;
+  if (r.operators.empty()) {
+    p = disp.at(laplacian_q(r.grid ? &*r.grid : nullptr, k));
+  } else {
+    if (!r.grid) throw UserError("linear stability: species operators need a grid (growth_at_k)");
+    double qs[kMaxSpecies];
+    for (int s = 0; s < r.nspecies; ++s)
+      qs[s] = op_q(r.operators[s], r.grid->dim, r.grid->h, k);
+    p = disp.at_species(qs);
+  }
+  p.k = std::sqrt(k[0] * k[0] + k[1] * k[1] + k[2] * k[2]);
   return p;
 }
 
@@ -299,65 +415,135 @@ StabilityResult analyse_jacobian(int n, const double* J, const double* D,
   }
   r.stable_homogeneous = r.growth0 < -r.tol;
 
-  // The dispersion curve sigma(k) along the direction.
-  std::array<double, 3> e = opt.direction;
+  // The dispersion curve sigma(k) along a direction e (unit vector, zero beyond the grid's dim).
+  const bool ops = !opt.operators.empty();
   const int dim = opt.grid ? opt.grid->dim : 3;
+  Stencil st;
+  if (ops) {
+    if (!opt.grid) throw UserError("linear stability: species operators need opt.grid (spacings)");
+    if (dim < 1 || dim > 3)
+      throw UserError("linear stability: grid dimension " + std::to_string(dim));
+    check_operators(opt.operators, n, dim);
+    r.operators = opt.operators;
+  } else if (opt.grid) {
+    st = stencil_of(*opt.grid);
+  }
+  std::array<double, 3> e0 = opt.direction;
   double norm = 0;
   for (int d = 0; d < 3; ++d) {
-    if (d >= dim) e[d] = 0;
-    norm += e[d] * e[d];
+    if (d >= dim) e0[d] = 0;
+    norm += e0[d] * e0[d];
   }
   if (!(norm > 0)) throw UserError("linear stability: the direction of k is zero");
-  for (double& c : e)
+  for (double& c : e0)
     c /= std::sqrt(norm);
-  Stencil st;
-  if (opt.grid) st = stencil_of(*opt.grid);
   const Dispersion disp{n, r.jacobian.data(), r.diffusion.data(), opt.dt, opt.general_eigensolver};
-  auto point = [&](double k) {
+  auto point = [&](const std::array<double, 3>& e, double k) {
     const std::array<double, 3> kv{k * e[0], k * e[1], k * e[2]};
-    DispersionPoint p = disp.at(opt.grid ? q_of(st, *opt.grid, kv) : k * k);
+    DispersionPoint p;
+    if (ops) {
+      double qs[kMaxSpecies];
+      for (int s = 0; s < n; ++s)
+        qs[s] = op_q(opt.operators[s], dim, opt.grid->h, kv);
+      p = disp.at_species(qs);
+    } else {
+      p = disp.at(opt.grid ? q_of(st, *opt.grid, kv) : k * k);
+    }
     p.k = k;
     return p;
   };
-  auto growth = [&](double k) { return point(k).growth; };
-
-  r.k_max = opt.k_max;
-  if (!(r.k_max > 0)) {
+  auto k_max_along = [&](const std::array<double, 3>& e) {
+    if (opt.k_max > 0) return opt.k_max;
     if (opt.grid) {
-      r.k_max = std::numeric_limits<double>::infinity();
+      double km = std::numeric_limits<double>::infinity();
       for (int d = 0; d < dim; ++d)
-        if (std::abs(e[d]) > 1e-12)
-          r.k_max = std::min(r.k_max, kPi / (opt.grid->h[d] * std::abs(e[d])));
-    } else {
-      double dmin = std::numeric_limits<double>::infinity();
-      for (int s = 0; s < n; ++s)
-        if (D[s] > 0) dmin = std::min(dmin, D[s]);
-      // All D = 0: sigma does not depend on k; any range will do.
-      r.k_max = std::isfinite(dmin) ? 3.0 * std::sqrt((scale > 0 ? scale : 1.0) / dmin) : 1.0;
+        if (std::abs(e[d]) > 1e-12) km = std::min(km, kPi / (opt.grid->h[d] * std::abs(e[d])));
+      return km;
+    }
+    double dmin = std::numeric_limits<double>::infinity();
+    for (int s = 0; s < n; ++s)
+      if (D[s] > 0) dmin = std::min(dmin, D[s]);
+    // All D = 0: sigma does not depend on k; any range will do.
+    return std::isfinite(dmin) ? 3.0 * std::sqrt((scale > 0 ? scale : 1.0) / dmin) : 1.0;
+  };
+
+  // Sample [0, k_max] along e and refine the maximum.
+  struct Ray {
+    std::array<double, 3> e;
+    double k_max = 0;
+    std::vector<DispersionPoint> curve;
+    int imax = 0;
+    double kbest = 0;
+    DispersionPoint best;
+  };
+  const int ns = opt.samples;
+  auto ray = [&](const std::array<double, 3>& e) {
+    Ray y;
+    y.e = e;
+    y.k_max = k_max_along(e);
+    auto growth = [&](double k) { return point(e, k).growth; };
+    y.curve.resize(ns);
+    double gmax = -std::numeric_limits<double>::infinity();
+    for (int i = 0; i < ns; ++i) {
+      y.curve[i] = point(e, y.k_max * i / (ns - 1));
+      gmax = std::max(gmax, y.curve[i].growth);
+    }
+    // The first sample within round-off of the maximum (flat curves: the smallest k).
+    int imax = 0;
+    while (imax + 1 < ns && !(y.curve[imax].growth >= gmax - 1e-3 * r.tol))
+      ++imax;
+    y.imax = imax;
+    // Refine the maximum inside the bracket of the best sample; keep an end if it is higher.
+    const double ktol = opt.k_tol * y.k_max;
+    const double a = y.curve[std::max(imax - 1, 0)].k, b = y.curve[std::min(imax + 1, ns - 1)].k;
+    double kbest = golden_max(growth, a, b, ktol);
+    for (double kc : {a, b, y.curve[imax].k})
+      if (growth(kc) > growth(kbest)) kbest = kc;
+    // Ties within round-off (flat curves, a maximum at k = 0): the smaller k.
+    if (growth(a) >= growth(kbest) - 1e-3 * r.tol) kbest = a;
+    y.kbest = kbest;
+    y.best = point(e, kbest);
+    return y;
+  };
+
+  Ray y = ray(e0);
+  if (ops && dim == 2 && opt.directions > 0) {
+    // The fastest direction: opt.direction unless a sampled one grows faster beyond round-off;
+    // the best sample refined by golden section on the angle.
+    auto dir = [](double t) { return std::array<double, 3>{std::cos(t), std::sin(t), 0}; };
+    const double dtheta = kPi / opt.directions;
+    int jbest = -1;
+    double gbest = y.best.growth;
+    for (int j = 0; j < opt.directions; ++j) {
+      const double g = ray(dir(j * dtheta)).best.growth;
+      if (g > gbest + 1e-3 * r.tol) gbest = g, jbest = j;
+    }
+    if (jbest >= 0) {
+      const double t0 = jbest * dtheta;
+      const double t = golden_max([&](double a) { return ray(dir(a)).best.growth; }, t0 - dtheta,
+                                  t0 + dtheta, 1e-9);
+      Ray yt = ray(dir(t));
+      y = yt.best.growth > gbest ? std::move(yt) : ray(dir(t0));
     }
   }
-  const int ns = opt.samples;
-  r.curve.resize(ns);
-  double gmax = -std::numeric_limits<double>::infinity();
-  for (int i = 0; i < ns; ++i) {
-    r.curve[i] = point(r.k_max * i / (ns - 1));
-    gmax = std::max(gmax, r.curve[i].growth);
-  }
-  // The first sample within round-off of the maximum (flat curves: the smallest k).
-  int imax = 0;
-  while (imax + 1 < ns && !(r.curve[imax].growth >= gmax - 1e-3 * r.tol))
-    ++imax;
 
-  // Refine the maximum inside the bracket of the best sample; keep an end if it is higher.
+  // Canonical direction: angle in [0, pi) (k and -k are the same mode).
+  r.direction = y.e;
+  double angle = std::atan2(y.e[1], y.e[0]);
+  if (angle < 0) angle += kPi;
+  if (angle >= kPi) angle -= kPi;
+  r.direction_fastest = angle;
+  r.k_max = y.k_max;
+  r.curve = std::move(y.curve);
+  const std::array<double, 3> e = y.e;
+  auto growth = [&](double k) { return point(e, k).growth; };
+  const int imax = y.imax;
+  const double kbest = y.kbest;
   const double ktol = opt.k_tol * r.k_max;
-  const double a = r.curve[std::max(imax - 1, 0)].k, b = r.curve[std::min(imax + 1, ns - 1)].k;
-  double kbest = golden_max(growth, a, b, ktol);
-  for (double kc : {a, b, r.curve[imax].k})
-    if (growth(kc) > growth(kbest)) kbest = kc;
-  // Ties within round-off (flat curves, a maximum at k = 0): the smaller k.
-  if (growth(a) >= growth(kbest) - 1e-3 * r.tol) kbest = a;
-  const DispersionPoint best = point(kbest);
+  const DispersionPoint best = y.best;
   r.k_fastest = best.k;
+  for (int d = 0; d < 3; ++d)
+    r.k_vector_fastest[d] = best.k * e[d];
   r.growth_fastest = best.growth;
   r.frequency_fastest = best.frequency;
   r.wavelength_fastest = best.k > 0 ? 2 * kPi / best.k : std::numeric_limits<double>::infinity();
@@ -413,6 +599,7 @@ StabilityResult analyse(const ModelEntry& entry, const std::vector<double>& para
     r.nspecies = n;
     r.diffusion = D;
     r.grid = opt.grid;
+    r.operators = opt.operators;
     r.dt = opt.dt;
     return r;
   }
@@ -449,9 +636,92 @@ std::vector<double> allowed_wavenumbers(const DiscreteGrid& grid, int axis) {
   return k;
 }
 
+namespace {
+
+// fastest_allowed_mode with per-species operators: q_s(k) = -sum_t w_t Re prod_d e^{i k_d o_d h_d}
+// from per-axis tables, every mode also with the sign combinations of its components when an
+// operator is not symmetric under the reflection of each axis.
+AllowedMode fastest_allowed_mode_ops(const StabilityResult& r, const DiscreteGrid& grid) {
+  const int n = r.nspecies, dim = grid.dim;
+  if (dim < 1 || dim > 3)
+    throw UserError("linear stability: grid dimension " + std::to_string(dim));
+  check_operators(r.operators, n, dim);
+  const bool signs = needs_sign_scan(r.operators, dim);
+  std::array<int, 3> R{0, 0, 0}; // largest |offset| per axis
+  for (const auto& op : r.operators)
+    for (const auto& o : op.off)
+      for (int d = 0; d < 3; ++d)
+        R[d] = std::max(R[d], std::abs(o[d]));
+  std::array<std::vector<double>, 3> k;
+  std::array<std::vector<std::complex<double>>, 3> E; // E[d][i (2R+1) + o + R] = e^{i k o h}
+  std::array<long long, 3> nyquist{-1, -1, -1};       // index with k_d h_d = pi (one sign)
+  for (int d = 0; d < 3; ++d) {
+    k[d] = d < dim ? allowed_wavenumbers(grid, d) : std::vector<double>{0.0};
+    const int w = 2 * R[d] + 1;
+    E[d].resize(k[d].size() * w);
+    for (size_t i = 0; i < k[d].size(); ++i)
+      for (int o = -R[d]; o <= R[d]; ++o)
+        E[d][i * w + o + R[d]] = std::polar(1.0, k[d][i] * o * (d < dim ? grid.h[d] : 0.0));
+    if (d < dim && grid.periodic[d] && grid.n[d] % 2 == 0) nyquist[d] = grid.n[d] / 2;
+  }
+  const Dispersion disp{n, r.jacobian.data(), r.diffusion.data(), r.dt, r.general_eigensolver};
+  AllowedMode best;
+  best.growth = -std::numeric_limits<double>::infinity();
+  const long long n0 = k[0].size(), n1 = k[1].size(), n2 = k[2].size();
+  for (long long i2 = 0; i2 < n2; ++i2)
+    for (long long i1 = 0; i1 < n1; ++i1)
+      for (long long i0 = 0; i0 < n0; ++i0) {
+        if (i0 == 0 && i1 == 0 && i2 == 0) continue;
+        const long long idx[3] = {i0, i1, i2};
+        // Axes whose sign matters; the first of them keeps its sign (k ~ -k).
+        int flippable = 0, first = -1;
+        if (signs)
+          for (int d = 0; d < dim; ++d)
+            if (idx[d] != 0 && idx[d] != nyquist[d]) {
+              flippable |= 1 << d;
+              if (first < 0) first = d;
+            }
+        for (int mask = 0; mask < (1 << dim); ++mask) {
+          if ((mask & ~flippable) != 0 || (first >= 0 && (mask >> first) & 1)) continue;
+          double qs[kMaxSpecies];
+          for (int s = 0; s < n; ++s) {
+            const SpeciesOperator& op = r.operators[s];
+            double sum = 0;
+            for (size_t t = 0; t < op.w.size(); ++t) {
+              std::complex<double> f = 1;
+              for (int d = 0; d < dim; ++d) {
+                const std::complex<double> e = E[d][idx[d] * (2 * R[d] + 1) + op.off[t][d] + R[d]];
+                f *= (mask >> d) & 1 ? std::conj(e) : e;
+              }
+              sum += op.w[t] * f.real();
+            }
+            qs[s] = -sum;
+          }
+          const DispersionPoint p = disp.at_species(qs);
+          ++best.scanned;
+          if (p.growth > best.growth) {
+            for (int d = 0; d < 3; ++d) {
+              const bool neg = (mask >> d) & 1;
+              best.m[d] = neg ? -idx[d] : idx[d];
+              best.k[d] = neg ? -k[d][idx[d]] : k[d][idx[d]];
+            }
+            best.growth = p.growth;
+            best.frequency = p.frequency;
+          }
+        }
+      }
+  best.q = std::numeric_limits<double>::quiet_NaN();
+  best.k_abs = std::sqrt(best.k[0] * best.k[0] + best.k[1] * best.k[1] + best.k[2] * best.k[2]);
+  best.wavelength = best.k_abs > 0 ? 2 * kPi / best.k_abs : 0;
+  return best;
+}
+
+} // namespace
+
 AllowedMode fastest_allowed_mode(const StabilityResult& r, const DiscreteGrid& grid) {
   if (!r.has_steady_state)
     throw UserError("linear stability: no steady state, so no fastest allowed mode");
+  if (!r.operators.empty()) return fastest_allowed_mode_ops(r, grid);
   const Stencil st = stencil_of(grid);
   std::array<std::vector<double>, 3> k, c; // wavenumbers and cos(k h) per axis
   for (int d = 0; d < 3; ++d) {
@@ -568,8 +838,13 @@ std::vector<std::vector<double>> find_steady_states(const ModelEntry& entry,
 
 std::string summary(const StabilityResult& r) {
   if (!r.has_steady_state) return "no homogeneous steady state";
+  // With per-species operators in 2-D, the direction of the fastest wave vector.
+  const std::string along =
+      !r.operators.empty() && r.grid && r.grid->dim == 2
+          ? ", direction " + fmt("%.3g", r.direction_fastest * 180 / kPi) + " deg"
+          : "";
   const std::string fastest = "fastest wavelength " + fmt("%.3g", r.wavelength_fastest) + " (k " +
-                              fmt("%.3g", r.k_fastest) + "), growth " +
+                              fmt("%.3g", r.k_fastest) + along + "), growth " +
                               fmt("%.3g", r.growth_fastest);
   std::string band;
   if (r.has_band)

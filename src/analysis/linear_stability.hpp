@@ -27,6 +27,24 @@
 // morphogen_core does not link LAPACK directly (PETSc's pkg-config gives only -lpetsc).
 // Pure computation: no MPI, no PETSc objects; bad input (sizes, unknown stencil) throws
 // UserError.
+//
+// Per-species (anisotropic) operators: with StabilityOptions::operators, species s diffuses by
+// its own constant-coefficient stencil L_s (weights w_t at integer offsets off_t, the diffusion
+// coefficient and 1/h^2 folded in), and
+//
+//   A(k) = J - diag(q_0(k), ..., q_{N-1}(k)),   q_s(k) = -sum_t w_t cos(k . (off_t * h)),
+//
+// (e.g. a tensor sigma on a 3x3 box: q_s = sigma11 4 sin^2(kx hx/2)/hx^2 + sigma22 4 sin^2(ky hy/2)
+// /hy^2 + 2 sigma12 sin(kx hx) sin(ky hy)/(hx hy)). The growth rate then depends on the direction
+// of k, not only on |k|. In 2-D the analysis samples `directions` directions in [0, pi), refines
+// the best one (golden section on the angle) and analyses the curve, k_fastest and the band along
+// the fastest direction (ties within round-off keep opt.direction, so operators D_s * (grid
+// stencil) reproduce the results without operators); this costs ~(directions + 45) curves. Note
+// that with ONE tensor shared by all species (sigma_s = D_s Sigma) the maximum growth is the same
+// in every direction (sigma depends on k only through k^T Sigma k; only the fastest |k| varies, ~
+// 1/sqrt(e^T Sigma e)), so the direction is then a tie and stays opt.direction; it is determined
+// when the species' tensors differ (in 2 x 2 activator-inhibitor kinetics: the direction maximising
+// e^T S_b e / e^T S_a e).
 #pragma once
 
 #include "app/model_registry.hpp"
@@ -56,16 +74,37 @@ struct DiscreteGrid {
 // and its boundary values generally differ from u*, so the analysis is only indicative there).
 DiscreteGrid discrete_grid(const GridSpec& spec, const std::string& stencil);
 
+// The discrete diffusion operator of one species as pure data: (L u)(x) = sum_t w[t] u(x + off[t]
+// * h), the diffusion coefficient (or tensor) and the spacings already in the weights. Must be
+// symmetric (the weight at -off equals that at off, to 1e-12 max |w|) and conserve mass (sum w =
+// 0, to 1e-12 sum |w|); offsets along axes >= the grid's dim must be 0. Empty: no diffusion.
+struct SpeciesOperator {
+  std::vector<std::array<int, 3>> off;
+  std::vector<double> w;
+};
+
+// q_s(k) = -sum_t w_t cos(k . (off_t * h)) (h: the grid's spacings).
+double operator_q(const SpeciesOperator& op, const std::array<double, 3>& h,
+                  const std::array<double, 3>& k);
+
 struct StabilityOptions {
-  std::optional<DiscreteGrid> grid;         // none: the continuous Laplacian, q = |k|^2
-  std::array<double, 3> direction{1, 0, 0}; // direction of k for the curve (grid symbol only)
-  double k_max = 0;           // 0: the grid's Nyquist pi/h along direction, or, continuous,
-                              //    3 sqrt(||J||_inf / min positive D) (a few times the fastest k)
-  int samples = 1024;         // sampled points of the dispersion curve on [0, k_max]
-  double k_tol = 1e-10;       // golden-section / bisection tolerance, relative to k_max
-  double dt = 0;              // > 0: rates of the forward Euler step, ln|1 + dt lambda| / dt
-  double zero_tol = 1e-9;     // relative to ||J||_inf: below it a rate counts as zero
-  std::vector<double> u_star; // analyse this state instead of the model's steady_state
+  std::optional<DiscreteGrid> grid; // none: the continuous Laplacian, q = |k|^2
+  // Direction of k for the curve (grid symbols and operators; with operators in 2-D, the
+  // fastest direction found replaces it unless `directions` is 0 or it ties).
+  std::array<double, 3> direction{1, 0, 0};
+  // Per-species operators (empty: D and the grid's stencil / the continuous Laplacian). When
+  // given: one per species, opt.grid is required (its dim and spacings; its stencil is unused),
+  // D is recorded but not used.
+  std::vector<SpeciesOperator> operators;
+  int directions = 180;   // operators in 2-D: directions sampled in [0, pi) for the fastest one;
+                          // 0: analyse along opt.direction only
+  double k_max = 0;       // 0: the grid's Nyquist pi/h along direction, or, continuous,
+                          //    3 sqrt(||J||_inf / min positive D) (a few times the fastest k)
+  int samples = 1024;     // sampled points of the dispersion curve on [0, k_max]
+  double k_tol = 1e-10;   // golden-section / bisection tolerance, relative to k_max
+  double dt = 0;          // > 0: rates of the forward Euler step, ln|1 + dt lambda| / dt
+  double zero_tol = 1e-9; // relative to ||J||_inf: below it a rate counts as zero
+  std::vector<double> u_star;       // analyse this state instead of the model's steady_state
   bool general_eigensolver = false; // the general path even for N = 2 (used by the tests)
 };
 
@@ -82,6 +121,7 @@ struct StabilityResult {
   std::vector<double> jacobian;  // J at u_star, N*N row-major
   std::vector<double> diffusion; // D
   std::optional<DiscreteGrid> grid;
+  std::vector<SpeciesOperator> operators; // as given (empty: D and the grid's stencil)
   double dt = 0;
   bool general_eigensolver = false;
   double tol = 0; // zero_tol * ||J||_inf
@@ -94,6 +134,12 @@ struct StabilityResult {
   bool marginal = false;
   bool oscillatory_fastest = false;
 
+  // The direction of the curve, k_fastest and the band (unit vector): opt.direction, or with
+  // operators in 2-D the fastest direction found. direction_fastest is its angle from the x axis
+  // in the x-y plane, in [0, pi); k_vector_fastest = k_fastest * direction.
+  std::array<double, 3> direction{1, 0, 0};
+  double direction_fastest = 0;
+  std::array<double, 3> k_vector_fastest{0, 0, 0};
   double k_fastest = 0; // argmax over [0, k_max] of sigma (0 when k = 0 grows fastest)
   double growth_fastest = 0;
   double frequency_fastest = 0;
@@ -102,14 +148,16 @@ struct StabilityResult {
   double k_lo = 0, k_hi = 0;
   bool band_open = false; // the band reaches k_max (sigma still positive there)
   double k_max = 0;
-  std::vector<DispersionPoint> curve; // the samples, k ascending
+  std::vector<DispersionPoint> curve; // the samples along `direction`, k ascending
 };
 
 // The fastest-growing non-uniform mode of a finite grid (what a simulation shows).
 struct AllowedMode {
-  std::array<long long, 3> m{0, 0, 0}; // mode numbers per axis (m_d >= 0)
-  std::array<double, 3> k{0, 0, 0};    // wave vector components
-  double k_abs = 0, q = 0, growth = 0, frequency = 0;
+  std::array<long long, 3> m{0, 0, 0}; // mode numbers per axis (m_d >= 0, but see below)
+  std::array<double, 3> k{0, 0, 0};    // wave vector components (signs as m)
+  double k_abs = 0;
+  double q = 0; // the Laplacian symbol (NaN with per-species operators: no single q)
+  double growth = 0, frequency = 0;
   double wavelength = 0; // 2 pi / |k|
   long long scanned = 0; // number of modes examined
 };
@@ -135,15 +183,28 @@ std::vector<double> default_params(const ModelEntry& entry);
 std::vector<double> default_diffusion(const ModelEntry& entry);
 
 // sigma and Im lambda of q for an analysed state (uses r's J, D, dt, eigensolver choice).
+// Isotropic case only (A = J - q diag(D)); throws if r has per-species operators.
 DispersionPoint growth_at_q(const StabilityResult& r, double q);
+
+// sigma and Im lambda at the wave vector k: with r's operators (and r.grid's spacings) if any,
+// else q = laplacian_q(r.grid, k) and D. DispersionPoint::k is |k|.
+DispersionPoint growth_at_k(const StabilityResult& r, const std::array<double, 3>& k);
 
 // Wavenumbers of axis `axis` of a grid: 2 pi m / L (periodic, m = 0..n/2) or pi m / L
 // (zero-flux, m = 0..n-1).
 std::vector<double> allowed_wavenumbers(const DiscreteGrid& grid, int axis);
 
 // The fastest-growing allowed mode with k != 0 over all mode vectors of the grid (every
-// n[d] >= 1; uses the grid's stencil symbol). Ties go to the mode scanned first. Cost: one
-// small eigenproblem per mode with m_d >= 0, (n/2 + 1)^dim of them (8192^2: ~1 s).
+// n[d] >= 1; uses the grid's stencil symbol, or r's operators, whose weights must be those of
+// this grid's spacings). Ties go to the mode scanned first. Cost: one small eigenproblem per
+// mode with m_d >= 0, (n/2 + 1)^dim of them (8192^2: ~1 s; with a sign scan, below, up to
+// 2^(dim-1) times that).
+// An operator that is not symmetric under the reflection of each axis (cross terms: a weight at
+// (1, 1) differing from that at (1, -1)) has q(kx, ky) != q(kx, -ky): then every mode is also
+// scanned with the sign combinations of its components (up to the overall sign, k ~ -k; axes
+// with k_d = 0 or at Nyquist, k_d h_d = pi, have one sign), the first axis with a non-trivial
+// sign kept positive, and m, k carry the signs. On zero-flux axes such operators do not separate
+// into cosine modes, and the mode is the fastest plane wave with those |k_d| (indicative).
 AllowedMode fastest_allowed_mode(const StabilityResult& r, const DiscreteGrid& grid);
 
 // Homogeneous steady states R(u) = 0 found by Newton's method from a lattice of starting points

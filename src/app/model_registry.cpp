@@ -27,6 +27,8 @@ template <class M> ModelEntry make_entry() {
   e.explicit_row[1][0] = &explicit_row<M, 3, false, true>;
   e.explicit_row[1][1] = &explicit_row<M, 5, false, true>;
   e.explicit_row[1][2] = &explicit_row<M, 3, true, true>;
+  e.explicit_pre[0] = &explicit_row_pre<M, false>;
+  e.explicit_pre[1] = &explicit_row_pre<M, true>;
   e.reaction_row[0] = &reaction_row<M, false>;
   e.reaction_row[1] = &reaction_row<M, true>;
   return e;

@@ -30,6 +30,8 @@ struct ModelEntry {
   // explicit_row[field_params][stencil]: stencil 0 = 5pt (3 star rows), 1 = 7pt (5 star rows),
   // 2 = 9pt (3 box rows); see RowStencil.
   ExplicitRowFn explicit_row[2][3];
+  // explicit_pre[field_params]: the general explicit path's update (diffusion precomputed).
+  ExplicitRowFn explicit_pre[2];
   // reaction_row[field_params]: the per-cell reaction substep of the split integrator.
   ReactionRowFn reaction_row[2];
 

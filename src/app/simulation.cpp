@@ -1,5 +1,6 @@
 #include "app/simulation.hpp"
 
+#include "app/diffusion_setup.hpp"
 #include "core/collective_error.hpp"
 #include "core/log_events.hpp"
 #include "core/user_error.hpp"
@@ -116,14 +117,28 @@ void Simulation::read_grid(Options& opt, const SequenceLevel& level) {
                     format_double(h[0]) + " and " + format_double(h[1]) + ")");
   spec_.stencil_width = 1;
   spec_.box_stencil = stencil_.nterms == 9;
+  read_diffusion_kinds(opt, st);
   grid_ = std::make_unique<Grid>(comm_, spec_);
   spec_ = grid_->spec();
   halo_ = std::make_unique<Halo>(*grid_);
 }
 
-void Simulation::read_model(Options& opt, const std::string& base_dir) {
+void Simulation::read_diffusion_kinds(Options& opt, const std::string& stencil) {
   const std::string name = opt.choice("model", "turing", model_names(), "reaction model");
   model_ = find_model(name);
+  tensor_.clear();
+  for (int s = 0; s < model_->nspecies; ++s) {
+    tensor_.push_back(read_tensor_choice(opt, model_->species[s].name));
+    if (!tensor_.back()) continue;
+    spec_.box_stencil = true; // cross terms read the ghost corners
+    if (stencil == "9pt")
+      throw UserError("-stencil 9pt: the isotropic 9-point stencil cannot be combined with "
+                      "-diffusion_" + std::string(model_->species[s].name) +
+                      " tensor (the tensor operator has its own box stencil); use -stencil 5pt");
+  }
+}
+
+void Simulation::read_model(Options& opt, const std::string& base_dir) {
   seed_ = static_cast<std::uint64_t>(
       opt.integer("seed", 1, 0, std::numeric_limits<PetscInt>::max(),
                   "seed of every random value (hashed with the key and the global cell index)"));
@@ -178,11 +193,17 @@ void Simulation::read_model(Options& opt, const std::string& base_dir) {
   dirichlet_.assign(any_dirichlet ? ns : 0, FaceValues{});
   u_.clear();
   work_.clear();
+  ops_.clear();
   for (int s = 0; s < ns; ++s) {
     const SpeciesInfo& si = model_->species[s];
     species_.emplace_back(si.name);
-    D_[s] = opt.real(std::string("D_") + si.name, si.D, 0.0, kMaxReal,
-                     std::string("diffusion coefficient of ") + si.name + " (" + si.doc + ")");
+    DiffusionSetup ds =
+        read_diffusion(opt, *grid_, *halo_, stencil_, si, tensor_[s], seed_, base_dir);
+    if (!ds.op->constant() && stencil_.nterms == 9)
+      throw UserError("-stencil 9pt: a diffusion map -D_" + std::string(si.name) +
+                      " needs -stencil 5pt (the map's operator has its own 5-point form)");
+    D_[s] = ds.D_mean;
+    ops_.push_back(std::move(ds.op));
     const std::string ikey = std::string("init_") + si.name;
     ValueSpec init(ikey,
                    opt.string(ikey, format_double(si.init),
@@ -247,6 +268,8 @@ void Simulation::read_model(Options& opt, const std::string& base_dir) {
       model_->row_kernel(params_.any_field(), rows.nrows, rows.box);
   integrator_ = std::make_unique<ExplicitIntegrator>(
       *grid_, *halo_, fn, ns, stencil_, D_, floor_, params_, any_dirichlet ? &dirichlet_ : nullptr);
+  if (!all_constant_diffusion())
+    integrator_->use_operators(operators(), model_->explicit_pre[params_.any_field() ? 1 : 0]);
   integrator_->update_ghosts(u_);
 }
 
@@ -261,7 +284,9 @@ void Simulation::read_time(Options& opt) {
   ts_ = kind == "ts";
   // With grid sequencing every level uses the finest level's dt and stability bound (the
   // bound scales with h^2), so a bad -dt fails before the first level writes anything.
-  stable_dt_ = ExplicitIntegrator::stable_dt(stencil_, D_) /
+  const bool constant = all_constant_diffusion();
+  stable_dt_ = (constant ? ExplicitIntegrator::stable_dt(stencil_, D_)
+                         : ExplicitIntegrator::stable_dt(operators())) /
                static_cast<double>(level_factor_ * level_factor_);
   const double def_dt = std::isfinite(stable_dt_) ? 0.9 * stable_dt_ : 1.0;
   dt_ = opt.real("dt", def_dt, 0.0, kMaxReal, "time step");
@@ -269,6 +294,18 @@ void Simulation::read_time(Options& opt) {
   if (!split_ && !ts_) {
     const bool force = opt.flag("force_dt", false,
                                 "run even when -dt exceeds the explicit diffusion stability bound");
+    double lmax = 0;
+    for (const auto& op : ops_)
+      lmax = std::max(lmax, op->max_eigenvalue());
+    if (dt_ > stable_dt_ && !force && !constant)
+      throw UserError("-dt " + format_double(dt_) +
+                      ": exceeds the explicit diffusion stability bound dt <= " +
+                      format_double(stable_dt_) +
+                      " (2/(lambda_max*rho(L)), the largest eigenvalue of the diffusion "
+                      "tensors/maps over the grid lambda_max = " +
+                      format_double(lmax) +
+                      "); use a smaller -dt, -integrator split (unconditionally stable "
+                      "diffusion), or -force_dt");
     if (dt_ > stable_dt_ && !force)
       throw UserError(
           "-dt " + format_double(dt_) + ": exceeds the explicit diffusion stability bound dt <= " +
@@ -291,10 +328,10 @@ void Simulation::read_time(Options& opt) {
          {"ts_type", "ts_arkimex_type", "ts_adapt_type", "ts_rtol", "ts_atol", "ts_monitor",
           "snes_type", "ksp_type", "pc_type", "sub_pc_type", "ksp_rtol"})
       opt.known(k);
-    laplacian_ = std::make_unique<LaplacianMatrix>(*grid_, *halo_, stencil_, model_->nspecies,
+    matrices_ = std::make_unique<OperatorMatrices>(*grid_, *halo_, stencil_, operators(),
                                                    dirichlet_.empty() ? nullptr : &dirichlet_);
-    ts_integrator_ = std::make_unique<TsIntegrator>(*grid_, model_->rates, species_, params_, D_,
-                                                    floor_, *laplacian_, sources_.get(), dt_);
+    ts_integrator_ = std::make_unique<TsIntegrator>(*grid_, model_->rates, species_, params_,
+                                                    floor_, *matrices_, sources_.get(), dt_);
   }
   if (split_) {
     SplitSettings set;
@@ -320,8 +357,9 @@ void Simulation::read_time(Options& opt) {
                               "relative tolerance of the per-cell Newton solve");
     set.newton_max_it = static_cast<int>(
         opt.integer("split_newton_max_it", 20, 1, 1000, "Newton iteration cap per cell"));
-    diffusion_ = std::make_unique<DiffusionSolver>(*grid_, *halo_, stencil_, species_, D_,
-                                                   dirichlet_.empty() ? nullptr : &dirichlet_, opt);
+    matrices_ = std::make_unique<OperatorMatrices>(*grid_, *halo_, stencil_, operators(),
+                                                   dirichlet_.empty() ? nullptr : &dirichlet_);
+    diffusion_ = std::make_unique<DiffusionSolver>(*grid_, *matrices_, species_, opt);
     diffusion_->prepare(dt_, set.theta);
     split_integrator_ = std::make_unique<SplitIntegrator>(
         *grid_, model_->reaction_row[params_.any_field() ? 1 : 0], species_, params_, floor_,
@@ -419,6 +457,19 @@ void Simulation::step() {
   }
   t_ += dt_;
   ++step_;
+}
+
+std::vector<const DiffusionOperator*> Simulation::operators() const {
+  std::vector<const DiffusionOperator*> out;
+  for (const auto& op : ops_)
+    out.push_back(op.get());
+  return out;
+}
+
+bool Simulation::all_constant_diffusion() const {
+  for (const auto& op : ops_)
+    if (!op->constant()) return false;
+  return true;
 }
 
 void Simulation::add_sources(double t) {

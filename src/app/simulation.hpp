@@ -59,7 +59,11 @@ public:
   const ModelEntry& model() const { return *model_; }
   const Grid& grid() const { return *grid_; }
   const std::vector<std::string>& species() const { return species_; }
+  // D_s of constant isotropic species; for maps and tensors the spatial mean isotropic part.
   const std::vector<double>& diffusion() const { return D_; }
+  // The species' diffusion operators (one per species).
+  std::vector<const DiffusionOperator*> operators() const;
+  bool all_constant_diffusion() const;
   std::vector<VecH>& state() { return u_; }
   const OutputSettings& output() const { return out_; }
   double dt() const { return dt_; }
@@ -92,6 +96,7 @@ public:
 private:
   void read_grid(Options& opt, const SequenceLevel& level);
   void start_from(Simulation& coarser);
+  void read_diffusion_kinds(Options& opt, const std::string& stencil);
   void read_model(Options& opt, const std::string& base_dir);
   void read_time(Options& opt);
   void read_output(Options& opt);
@@ -110,11 +115,13 @@ private:
   ParamSet params_;
   std::vector<FaceValues> dirichlet_;
   std::vector<VecH> u_, work_;
+  std::vector<bool> tensor_; // per species: -diffusion_S tensor
+  std::vector<std::unique_ptr<DiffusionOperator>> ops_;
+  std::unique_ptr<OperatorMatrices> matrices_; // split and TS; before the integrators using it
   std::unique_ptr<ExplicitIntegrator> integrator_;
   std::unique_ptr<SourceTerms> sources_;
   std::unique_ptr<DiffusionSolver> diffusion_;
   std::unique_ptr<SplitIntegrator> split_integrator_;
-  std::unique_ptr<LaplacianMatrix> laplacian_; // TS only; before ts_integrator_ (destroyed after)
   std::unique_ptr<TsIntegrator> ts_integrator_;
   bool split_ = false, ts_ = false;
   PetscInt level_factor_ = 1; // coarsening factor of this sequencing level (1: finest)

@@ -97,12 +97,21 @@ PetscInt Halo::face_index(int d, PetscInt i, PetscInt j, PetscInt k) const {
 }
 
 void Halo::fill_boundaries(double* u, const FaceValues* dirichlet) const {
+  fill_faces(u, dirichlet, {1.0, 1.0, 1.0});
+}
+
+void Halo::fill_mirror(double* u, const std::array<double, 3>& sign) const {
+  fill_faces(u, nullptr, sign);
+}
+
+void Halo::fill_faces(double* u, const FaceValues* dirichlet,
+                      const std::array<double, 3>& sign) const {
   const GridSpec& g = grid_.spec();
   const Box& gb = grid_.ghosted();
   const PetscInt str[3] = {1, gb.m[0], gb.m[0] * gb.m[1]};
   for (int d = 0; d < grid_.dim(); ++d) {
     if (g.bc[d] == Boundary::Periodic) continue;
-    const bool dir = g.bc[d] == Boundary::Dirichlet;
+    const bool dir = g.bc[d] == Boundary::Dirichlet && dirichlet;
     for (int side = 0; side < 2; ++side) {
       // Ghost layers beyond this face owned by this rank's ghost box.
       for (PetscInt layer = 1; layer <= g.stencil_width; ++layer) {
@@ -120,7 +129,7 @@ void Halo::fill_boundaries(double* u, const FaceValues* dirichlet) const {
             for (PetscInt i = lo[0]; i < hi[0]; ++i) {
               const PetscInt gi = grid_.local_index(i, j, k);
               const PetscInt mi = gi + (mirror - ghost) * str[d];
-              u[gi] = dir ? 2.0 * (*vals)[face_index(d, i, j, k)] - u[mi] : u[mi];
+              u[gi] = dir ? 2.0 * (*vals)[face_index(d, i, j, k)] - u[mi] : sign[d] * u[mi];
             }
       }
     }

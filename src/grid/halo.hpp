@@ -31,6 +31,10 @@ public:
   // Fill ghosts outside non-periodic boundaries (after end()). `dirichlet` may be null when no
   // axis is Dirichlet.
   void fill_boundaries(double* a, const FaceValues* dirichlet) const;
+  // Fill ghosts outside non-periodic boundaries with the mirror value times sign[d] for the
+  // face normal to axis d, whatever the boundary type (coefficient fields: a tensor's
+  // off-diagonal component changes sign under a reflection, so its mirror image is odd).
+  void fill_mirror(double* a, const std::array<double, 3>& sign) const;
   // The whole update: begin, end, fill_boundaries.
   void update(double* a, const FaceValues* dirichlet) const {
     begin(a);
@@ -44,6 +48,8 @@ public:
   PetscInt face_size(int d) const;
 
 private:
+  void fill_faces(double* a, const FaceValues* dirichlet, const std::array<double, 3>& sign) const;
+
   const Grid& grid_;
   SFH sf_;
 };

@@ -10,11 +10,9 @@
 
 namespace morphogen {
 
-DiffusionSolver::DiffusionSolver(const Grid& grid, const Halo& halo, const Stencil& stencil,
-                                 const std::vector<std::string>& species,
-                                 const std::vector<double>& D,
-                                 const std::vector<FaceValues>* dirichlet, Options& opt)
-    : grid_(grid), halo_(halo), species_(species), D_(D) {
+DiffusionSolver::DiffusionSolver(const Grid& grid, const OperatorMatrices& ops,
+                                 const std::vector<std::string>& species, Options& opt)
+    : grid_(grid), ops_(ops), species_(species) {
   const size_t ns = species.size();
   A_.assign(ns, nullptr);
   ksp_.assign(ns, nullptr);
@@ -23,8 +21,6 @@ DiffusionSolver::DiffusionSolver(const Grid& grid, const Halo& halo, const Stenc
   iterations_.assign(ns, 0);
   rhs_ = grid.create_global();
   tmp_ = grid.create_global();
-  has_dirichlet_ = dirichlet != nullptr && !dirichlet->empty();
-  lap_ = std::make_unique<LaplacianMatrix>(grid, halo, stencil, static_cast<int>(ns), dirichlet);
   // Defaults of our KSP prefix, overridable from the options database.
   int size = 1;
   MPI_Comm_size(grid.comm(), &size);
@@ -68,7 +64,15 @@ void DiffusionSolver::configure(int s) {
   KSP& ksp = ksp_[s];
   MG_PETSC(KSPCreate(grid_.comm(), &ksp));
   MG_PETSC(KSPSetOptionsPrefix(ksp, "diffusion_"));
-  set_cg_icc(ksp);
+  if (ops_.symmetric(s)) {
+    set_cg_icc(ksp);
+  } else {
+    // The first-order tensor masks give a non-symmetric matrix: GMRES with ILU (blocks).
+    MG_PETSC(KSPSetType(ksp, KSPGMRES));
+    PC pc;
+    MG_PETSC(KSPGetPC(ksp, &pc));
+    MG_PETSC(PCSetType(pc, size == 1 ? PCILU : PCBJACOBI));
+  }
   MG_PETSC(KSPSetTolerances(ksp, 1e-10, 1e-14, PETSC_DEFAULT, 10000));
   // The DMDA lets -diffusion_pc_type mg build its grid hierarchy; the operator is ours.
   MG_PETSC(KSPSetDM(ksp, grid_.dm()));
@@ -85,37 +89,37 @@ void DiffusionSolver::configure(int s) {
 }
 
 void DiffusionSolver::prepare_species(int s, double dt, double theta) {
-  if (D_[s] == 0.0 || (assembled_dt_[s] == dt && assembled_theta_[s] == theta)) return;
+  if (ops_.scale(s) == 0.0 || (assembled_dt_[s] == dt && assembled_theta_[s] == theta)) return;
   if (A_[s]) MG_PETSC(MatDestroy(&A_[s]));
-  MG_PETSC(MatDuplicate(lap_->L(), MAT_COPY_VALUES, &A_[s]));
-  MG_PETSC(MatScale(A_[s], -theta * dt * D_[s]));
+  MG_PETSC(MatDuplicate(ops_.M(s), MAT_COPY_VALUES, &A_[s]));
+  MG_PETSC(MatScale(A_[s], -theta * dt * ops_.scale(s)));
   MG_PETSC(MatShift(A_[s], 1.0));
   MG_PETSC(KSPSetOperators(ksp_[s], A_[s], A_[s]));
-  if (assembled_dt_[s] < 0) icc_subblocks(ksp_[s], "-diffusion_sub_pc_type");
+  if (assembled_dt_[s] < 0 && ops_.symmetric(s)) icc_subblocks(ksp_[s], "-diffusion_sub_pc_type");
   assembled_dt_[s] = dt;
   assembled_theta_[s] = theta;
 }
 
 void DiffusionSolver::prepare(double dt, double theta) {
-  for (size_t s = 0; s < D_.size(); ++s)
-    prepare_species(static_cast<int>(s), dt, theta);
+  for (int s = 0; s < ops_.nspecies(); ++s)
+    prepare_species(s, dt, theta);
 }
 
 void DiffusionSolver::solve(int s, Vec u, double dt, double theta, PetscInt step) {
   LogScope log_scope(log_events().diffusion);
-  if (D_[s] == 0.0) {
+  if (ops_.scale(s) == 0.0) {
     iterations_[s] = 0;
     return;
   }
-  const double c = dt * D_[s];
+  const double c = dt * ops_.scale(s);
   prepare_species(s, dt, theta);
   // rhs = u + (1 - theta) c L u + c b
   MG_PETSC(VecCopy(u, rhs_));
   if (theta != 1.0) {
-    MG_PETSC(MatMult(lap_->L(), u, tmp_));
+    MG_PETSC(MatMult(ops_.M(s), u, tmp_));
     MG_PETSC(VecAXPY(rhs_, (1.0 - theta) * c, tmp_));
   }
-  if (has_dirichlet_) MG_PETSC(VecAXPY(rhs_, c, lap_->b(s)));
+  if (ops_.has_dirichlet()) MG_PETSC(VecAXPY(rhs_, c, ops_.b(s)));
   MG_PETSC(KSPSolve(ksp_[s], rhs_, u));
   KSPConvergedReason reason;
   MG_PETSC(KSPGetConvergedReason(ksp_[s], &reason));

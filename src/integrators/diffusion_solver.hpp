@@ -2,14 +2,16 @@
 //
 //   (I - theta dt D_s L) u_s^{n+1} = (I + (1 - theta) dt D_s L) u_s^n + dt D_s b_s
 //
-// theta = 1: backward Euler; theta = 1/2: Crank-Nicolson. L is the discrete Laplacian of the
-// chosen stencil with the boundary conditions folded in, assembled once on the DMDA: for a
+// theta = 1: backward Euler; theta = 1/2: Crank-Nicolson. D_s (L + b_s) is the species'
+// diffusion operator (operators/operator_matrices.hpp: scale_s (M_s + b_s); for constant
+// isotropic diffusion D_s times the stencil's Laplacian), assembled once on the DMDA: for a
 // neighbour outside a zero-flux boundary the coefficient moves to its mirror cell
 // (u_ghost = u_inside); outside a Dirichlet boundary it moves with a minus sign and the constant
 // 2 g w goes into b_s (u_ghost = 2 g - u_inside) - the same ghost rules as the explicit halo,
 // so L u + b equals the explicit scheme's Laplacian. The matrices A_s are assembled once per
 // (dt, theta) and reused. Solver: KSP CG with ICC on one rank and block Jacobi with ICC blocks
-// in parallel, relative tolerance 1e-10; every choice can be overridden with -diffusion_ksp_*
+// in parallel (GMRES with ILU for the non-symmetric first-order tensor masks), relative
+// tolerance 1e-10; every choice can be overridden with -diffusion_ksp_*
 // and -diffusion_pc_* options (e.g. -diffusion_pc_type mg for geometric multigrid on the
 // DMDA, -diffusion_pc_type hypre, or -diffusion_ksp_type richardson -diffusion_pc_type jacobi
 // or sor for Sanderson's relaxation). A diverged solve is reported with species, KSP reason and
@@ -18,7 +20,7 @@
 
 #include "core/options.hpp"
 #include "grid/halo.hpp"
-#include "operators/laplacian_matrix.hpp"
+#include "operators/operator_matrices.hpp"
 #include "operators/stencil.hpp"
 
 #include <memory>
@@ -30,9 +32,9 @@ namespace morphogen {
 
 class DiffusionSolver {
 public:
-  DiffusionSolver(const Grid& grid, const Halo& halo, const Stencil& stencil,
-                  const std::vector<std::string>& species, const std::vector<double>& D,
-                  const std::vector<FaceValues>* dirichlet, Options& opt);
+  // ops: the species' diffusion operators as matrices (kept by reference).
+  DiffusionSolver(const Grid& grid, const OperatorMatrices& ops,
+                  const std::vector<std::string>& species, Options& opt);
   ~DiffusionSolver();
   DiffusionSolver(const DiffusionSolver&) = delete;
   DiffusionSolver& operator=(const DiffusionSolver&) = delete;
@@ -45,24 +47,21 @@ public:
 
   PetscInt last_iterations(int s) const { return iterations_[s]; }
   PetscInt total_iterations() const { return total_its_; }
-  const LaplacianMatrix& laplacian() const { return *lap_; }
+  const OperatorMatrices& operators() const { return ops_; }
 
 private:
   void configure(int s);
   void prepare_species(int s, double dt, double theta);
 
   const Grid& grid_;
-  const Halo& halo_;
+  const OperatorMatrices& ops_;
   std::vector<std::string> species_;
-  std::vector<double> D_;
-  std::unique_ptr<LaplacianMatrix> lap_;
   std::vector<Mat> A_;
   std::vector<KSP> ksp_;
   std::vector<double> assembled_dt_, assembled_theta_;
   std::vector<PetscInt> iterations_;
   PetscInt total_its_ = 0;
   VecH rhs_, tmp_;
-  bool has_dirichlet_ = false;
 };
 
 } // namespace morphogen

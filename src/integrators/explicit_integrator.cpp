@@ -28,6 +28,19 @@ double ExplicitIntegrator::stable_dt(const Stencil& stencil, const std::vector<d
   return dmax > 0 && rho > 0 ? 2.0 / (dmax * rho) : std::numeric_limits<double>::infinity();
 }
 
+double ExplicitIntegrator::stable_dt(const std::vector<const DiffusionOperator*>& ops) {
+  double r = 0;
+  for (const DiffusionOperator* op : ops)
+    r = std::max(r, op->radius());
+  return r > 0 ? 2.0 / r : std::numeric_limits<double>::infinity();
+}
+
+void ExplicitIntegrator::use_operators(std::vector<const DiffusionOperator*> ops, RowFn pre_fn) {
+  ops_ = std::move(ops);
+  pre_fn_ = pre_fn;
+  div_.assign(static_cast<size_t>(ns_), std::vector<double>(grid_.owned().m[0]));
+}
+
 void ExplicitIntegrator::update_ghosts(std::vector<VecH>& u) const {
   LogScope log_scope(log_events().halo);
   std::vector<PetscScalar*> a(ns_);
@@ -43,8 +56,62 @@ void ExplicitIntegrator::update_ghosts(std::vector<VecH>& u) const {
     MG_PETSC(VecRestoreArray(u[s], &a[s]));
 }
 
+void ExplicitIntegrator::step_general(std::vector<VecH>& u, std::vector<VecH>& work,
+                                      double dt) const {
+  LogScope log_scope(log_events().sweep);
+  const int np = static_cast<int>(params_.scalar.size());
+  std::vector<const PetscScalar*> in(ns_), pf(np, nullptr);
+  std::vector<PetscScalar*> out(ns_);
+  for (int s = 0; s < ns_; ++s) {
+    MG_PETSC(VecGetArrayRead(u[s], &in[s]));
+    MG_PETSC(VecGetArray(work[s], &out[s]));
+  }
+  for (int q = 0; q < np; ++q)
+    if (params_.field[q].get()) MG_PETSC(VecGetArrayRead(params_.field[q], &pf[q]));
+  const Box& ob = grid_.owned();
+  std::vector<const double*> src(ns_), div(ns_), prow(np, nullptr);
+  std::vector<double*> dst(ns_);
+  for (int s = 0; s < ns_; ++s)
+    div[s] = div_[s].data();
+  ExplicitRow row;
+  row.n = static_cast<int>(ob.m[0]);
+  row.src = src.data();
+  row.div = div.data();
+  row.floor = floor_.data();
+  row.prow = prow.data();
+  row.pconst = params_.scalar.data();
+  row.dt = dt;
+  row.dst = dst.data();
+  for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
+    for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j) {
+      const PetscInt c = grid_.local_index(ob.s[0], j, k);
+      for (int s = 0; s < ns_; ++s) {
+        ops_[s]->apply_row(in[s], c, row.n, div_[s].data());
+        src[s] = in[s] + c;
+        dst[s] = out[s] + c;
+      }
+      if (params_.any_field()) {
+        const PetscInt o = grid_.owned_index(ob.s[0], j, k);
+        for (int q = 0; q < np; ++q)
+          prow[q] = pf[q] ? pf[q] + o : const_rows_[q].data();
+      }
+      pre_fn_(row);
+    }
+  for (int q = 0; q < np; ++q)
+    if (pf[q]) MG_PETSC(VecRestoreArrayRead(params_.field[q], &pf[q]));
+  for (int s = 0; s < ns_; ++s) {
+    MG_PETSC(VecRestoreArrayRead(u[s], &in[s]));
+    MG_PETSC(VecRestoreArray(work[s], &out[s]));
+  }
+  std::swap(u, work);
+}
+
 void ExplicitIntegrator::step(std::vector<VecH>& u, std::vector<VecH>& work, double dt) const {
   update_ghosts(u);
+  if (!ops_.empty()) {
+    step_general(u, work, dt);
+    return;
+  }
   LogScope log_scope(log_events().sweep);
   const int nr = rows_.nrows;
   const int np = static_cast<int>(params_.scalar.size());

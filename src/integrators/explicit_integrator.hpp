@@ -8,11 +8,16 @@
 // written into a second set, and the two are swapped (no global-to-local copy per step).
 // The step is stable for dt <= 2 / (D_max * spectral_radius(L)) (the diffusion bound,
 // dt <= h^2 / (2 dim D_max) for the 5/7-point Laplacian).
+// General path (any species with a diffusion field or tensor): per grid row, each species'
+// diffusion (DiffusionOperator::apply_row) goes into a row buffer, then the model's
+// explicit_row_pre adds the reaction and writes the row, so the tile stays in cache; stable for
+// dt <= 2 / max_s radius_s (lambda_max of the tensors over the grid).
 #pragma once
 
 #include "fields/param_set.hpp"
 #include "grid/halo.hpp"
 #include "integrators/explicit_kernel.hpp"
+#include "operators/diffusion_operator.hpp"
 #include "operators/stencil.hpp"
 
 #include <vector>
@@ -34,8 +39,18 @@ public:
 
   // Largest stable dt for this stencil and these diffusion coefficients (inf if D = 0).
   static double stable_dt(const Stencil& stencil, const std::vector<double>& D);
+  // Largest stable dt for these operators: 2 / max radius (inf if all are zero).
+  static double stable_dt(const std::vector<const DiffusionOperator*>& ops);
+
+  // Switch to the general path: each species' diffusion from its operator (into a row buffer),
+  // then pre_fn adds the reaction and writes the row (explicit_row_pre of the model). Used when
+  // any operator is not constant isotropic; the fused fast path is kept otherwise.
+  void use_operators(std::vector<const DiffusionOperator*> ops, RowFn pre_fn);
+  bool general() const { return !ops_.empty(); }
 
 private:
+  void step_general(std::vector<VecH>& u, std::vector<VecH>& work, double dt) const;
+
   const Grid& grid_;
   const Halo& halo_;
   RowFn row_fn_;
@@ -46,6 +61,9 @@ private:
   const ParamSet& params_;
   const std::vector<FaceValues>* dirichlet_;
   std::vector<std::vector<double>> const_rows_; // constant params expanded to a row (field mode)
+  std::vector<const DiffusionOperator*> ops_;   // general path (empty: fused fast path)
+  RowFn pre_fn_ = nullptr;
+  mutable std::vector<std::vector<double>> div_; // per species row buffer of the general path
 };
 
 } // namespace morphogen

@@ -28,6 +28,7 @@ struct ExplicitRow {
   const double* pconst = nullptr;      // [nparams] parameter scalars (scalar mode)
   double dt = 0;
   double* const* dst = nullptr; // [nspecies] output rows
+  const double* const* div = nullptr; // [nspecies] precomputed diffusion rows (general path)
 };
 
 template <class M, int NR, bool Box, bool FieldParams>
@@ -79,6 +80,51 @@ inline void explicit_row(const ExplicitRow& a) {
           lap += w[q][1] * row[i];
       }
       const double v = u[s] + dt * (D[s] * lap + r[s]);
+      dst[s][i] = v > floor[s] ? v : floor[s];
+    }
+  }
+}
+
+// The general path's update of one row: the diffusion terms were computed into div[s] (a row
+// buffer, operators/diffusion_operator.hpp) and are added with the reaction:
+//   out_s = max( u_s + dt (div_s + R_s(u; p)),  floor_s )
+// src[s] is species s's row (one row per species, no neighbours read).
+template <class M, bool FieldParams> inline void explicit_row_pre(const ExplicitRow& a) {
+  constexpr int NS = M::nspecies;
+  constexpr int NP = M::nparams;
+  const double* __restrict__ src[NS];
+  const double* __restrict__ div[NS];
+  double* __restrict__ dst[NS];
+  double floor[NS], pc[NP > 0 ? NP : 1];
+  const double* __restrict__ prow[NP > 0 ? NP : 1];
+  for (int s = 0; s < NS; ++s) {
+    src[s] = a.src[s];
+    div[s] = a.div[s];
+    dst[s] = a.dst[s];
+    floor[s] = a.floor[s];
+  }
+  for (int q = 0; q < NP; ++q) {
+    if constexpr (FieldParams)
+      prow[q] = a.prow[q];
+    else
+      pc[q] = a.pconst[q];
+  }
+  const double dt = a.dt;
+  const int n = a.n;
+#pragma GCC ivdep
+  for (int i = 0; i < n; ++i) {
+    double u[NS], r[NS], p[NP > 0 ? NP : 1];
+    for (int q = 0; q < NP; ++q) {
+      if constexpr (FieldParams)
+        p[q] = prow[q][i];
+      else
+        p[q] = pc[q];
+    }
+    for (int s = 0; s < NS; ++s)
+      u[s] = src[s][i];
+    M::rates(u, p, r);
+    for (int s = 0; s < NS; ++s) {
+      const double v = u[s] + dt * (div[s][i] + r[s]);
       dst[s][i] = v > floor[s] ? v : floor[s];
     }
   }

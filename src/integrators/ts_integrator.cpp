@@ -27,14 +27,14 @@ struct QuietPetscErrors {
 } // namespace
 
 TsIntegrator::TsIntegrator(const Grid& grid, RatesFn rates, const std::vector<std::string>& species,
-                           const ParamSet& params, const std::vector<double>& D,
-                           std::vector<double> floor, const LaplacianMatrix& lap,
+                           const ParamSet& params, std::vector<double> floor,
+                           const OperatorMatrices& ops,
                            SourceTerms* sources, double dt)
-    : grid_(grid), rates_(rates), species_(species), params_(params), D_(D),
-      floor_(std::move(floor)), lap_(lap), sources_(sources) {
+    : grid_(grid), rates_(rates), species_(species), params_(params),
+      floor_(std::move(floor)), ops_(ops), sources_(sources) {
   ns_ = static_cast<PetscInt>(species.size());
   nloc_ = grid.owned().size();
-  if (D_.size() != species.size() || floor_.size() != species.size() ||
+  if (ops_.nspecies() != static_cast<int>(species.size()) || floor_.size() != species.size() ||
       params_.scalar.size() != params_.field.size() || !rates_)
     throw std::logic_error("TsIntegrator: species, D, floor or parameter sizes disagree");
   cell_u_.assign(species.size(), 0.0);
@@ -80,18 +80,18 @@ void TsIntegrator::build_operator() {
     return ns_ * ranges[r] + s * (ranges[r + 1] - ranges[r]) + (g - ranges[r]);
   };
 
-  Mat L = lap_.L();
   std::vector<PetscInt> dnz(static_cast<size_t>(nb)), onz(static_cast<size_t>(nb));
-  for (PetscInt g = rstart; g < rend; ++g) {
-    PetscInt nc = 0;
-    const PetscInt* cols = nullptr;
-    MG_PETSC(MatGetRow(L, g, &nc, &cols, nullptr));
-    PetscInt d = 0;
-    for (PetscInt c = 0; c < nc; ++c)
-      d += cols[c] >= rstart && cols[c] < rend;
-    const PetscInt o = nc - d;
-    MG_PETSC(MatRestoreRow(L, g, &nc, &cols, nullptr)); // (zeroes nc)
-    for (PetscInt s = 0; s < ns_; ++s) {
+  for (PetscInt s = 0; s < ns_; ++s) {
+    Mat L = ops_.M(static_cast<int>(s));
+    for (PetscInt g = rstart; g < rend; ++g) {
+      PetscInt nc = 0;
+      const PetscInt* cols = nullptr;
+      MG_PETSC(MatGetRow(L, g, &nc, &cols, nullptr));
+      PetscInt d = 0;
+      for (PetscInt c = 0; c < nc; ++c)
+        d += cols[c] >= rstart && cols[c] < rend;
+      const PetscInt o = nc - d;
+      MG_PETSC(MatRestoreRow(L, g, &nc, &cols, nullptr)); // (zeroes nc)
       dnz[static_cast<size_t>(s * nloc_ + g - rstart)] = d;
       onz[static_cast<size_t>(s * nloc_ + g - rstart)] = o;
     }
@@ -103,23 +103,25 @@ void TsIntegrator::build_operator() {
   MG_PETSC(MatMPIAIJSetPreallocation(Dblock_, 0, dnz.data(), 0, onz.data()));
   std::vector<PetscInt> bcols;
   std::vector<PetscScalar> bvals;
-  for (PetscInt g = rstart; g < rend; ++g) {
-    PetscInt nc = 0;
-    const PetscInt* cols = nullptr;
-    const PetscScalar* vals = nullptr;
-    MG_PETSC(MatGetRow(L, g, &nc, &cols, &vals));
-    bcols.resize(static_cast<size_t>(nc));
-    bvals.resize(static_cast<size_t>(nc));
-    for (PetscInt s = 0; s < ns_; ++s) {
+  for (PetscInt s = 0; s < ns_; ++s) {
+    Mat L = ops_.M(static_cast<int>(s));
+    const double scale = ops_.scale(static_cast<int>(s));
+    for (PetscInt g = rstart; g < rend; ++g) {
+      PetscInt nc = 0;
+      const PetscInt* cols = nullptr;
+      const PetscScalar* vals = nullptr;
+      MG_PETSC(MatGetRow(L, g, &nc, &cols, &vals));
+      bcols.resize(static_cast<size_t>(nc));
+      bvals.resize(static_cast<size_t>(nc));
       const PetscInt row = bstart + s * nloc_ + (g - rstart);
       for (PetscInt c = 0; c < nc; ++c) {
         bcols[static_cast<size_t>(c)] = block_col(cols[c], s);
-        bvals[static_cast<size_t>(c)] = D_[static_cast<size_t>(s)] * vals[c];
+        bvals[static_cast<size_t>(c)] = scale * vals[c];
       }
-      // Kept even where D_s = 0: the pattern (with its diagonal) stays that of L.
+      // Kept even where the scale is 0: the pattern (with its diagonal) stays that of M_s.
       MG_PETSC(MatSetValues(Dblock_, 1, &row, nc, bcols.data(), bvals.data(), INSERT_VALUES));
+      MG_PETSC(MatRestoreRow(L, g, &nc, &cols, &vals));
     }
-    MG_PETSC(MatRestoreRow(L, g, &nc, &cols, &vals));
   }
   MG_PETSC(MatAssemblyBegin(Dblock_, MAT_FINAL_ASSEMBLY));
   MG_PETSC(MatAssemblyEnd(Dblock_, MAT_FINAL_ASSEMBLY));
@@ -136,12 +138,13 @@ void TsIntegrator::build_operator() {
   int local_b = 0;
   for (PetscInt s = 0; s < ns_; ++s) {
     const PetscScalar* b = nullptr;
-    MG_PETSC(VecGetArrayRead(lap_.b(static_cast<int>(s)), &b));
+    const double scale = ops_.scale(static_cast<int>(s));
+    MG_PETSC(VecGetArrayRead(ops_.b(static_cast<int>(s)), &b));
     for (PetscInt c = 0; c < nloc_; ++c) {
-      bd[s * nloc_ + c] = D_[static_cast<size_t>(s)] * b[c];
+      bd[s * nloc_ + c] = scale * b[c];
       local_b |= bd[s * nloc_ + c] != 0.0;
     }
-    MG_PETSC(VecRestoreArrayRead(lap_.b(static_cast<int>(s)), &b));
+    MG_PETSC(VecRestoreArrayRead(ops_.b(static_cast<int>(s)), &b));
   }
   MG_PETSC(VecRestoreArray(bD_, &bd));
   int any_b = 0;

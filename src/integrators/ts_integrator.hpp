@@ -1,14 +1,15 @@
 // PETSc TS integrator (IMEX additive Runge-Kutta):
 //
-//   du_s/dt = D_s L u_s + D_s b_s          (implicit: stiff, linear)
+//   du_s/dt = K_s u_s                      (implicit: stiff, linear; the species' diffusion
+//                                           operator scale_s (M_s u + b_s))
 //           + R_s(u; p) + S_s(x, t)        (explicit: reaction and source terms, cell by cell)
 //
-// L and b_s are the Laplacian matrix and Dirichlet vectors of operators/laplacian_matrix.hpp
-// (L u + b_s equals the explicit scheme's Laplacian with boundary conditions).
+// M_s, scale_s and b_s come from operators/operator_matrices.hpp (the explicit scheme's
+// operator with the boundary conditions folded in).
 //
 // Layout: one MPI Vec X holds every species; this rank's block is species 0's owned cells
 // (owned layout, x fastest), then species 1's, ... (local size nspecies * owned cells). The
-// implicit operator is blockdiag(D_s L) in that layout, assembled once by copying L's rows with
+// implicit operator is blockdiag(scale_s M_s) in that layout, assembled once by copying the rows with
 // column indices mapped to the block layout; the IJacobian shift*I - blockdiag(D_s L) is
 // refreshed from it only when the shift changes (so a fixed dt factors the preconditioner once).
 //
@@ -41,7 +42,7 @@
 
 #include "fields/param_set.hpp"
 #include "fields/source_terms.hpp"
-#include "operators/laplacian_matrix.hpp"
+#include "operators/operator_matrices.hpp"
 
 #include <exception>
 #include <petscts.h>
@@ -58,8 +59,8 @@ public:
   // the step of step() calls (and the largest internal step when adaptive); the integrator
   // keeps references to grid, params, lap and sources.
   TsIntegrator(const Grid& grid, RatesFn rates, const std::vector<std::string>& species,
-               const ParamSet& params, const std::vector<double>& D, std::vector<double> floor,
-               const LaplacianMatrix& lap, SourceTerms* sources, double dt);
+               const ParamSet& params, std::vector<double> floor, const OperatorMatrices& ops,
+               SourceTerms* sources, double dt);
   ~TsIntegrator();
   TsIntegrator(const TsIntegrator&) = delete;
   TsIntegrator& operator=(const TsIntegrator&) = delete;
@@ -93,14 +94,14 @@ private:
   RatesFn rates_;
   std::vector<std::string> species_;
   const ParamSet& params_;
-  std::vector<double> D_, floor_;
-  const LaplacianMatrix& lap_;
+  std::vector<double> floor_;
+  const OperatorMatrices& ops_;
   SourceTerms* sources_;
   PetscInt ns_ = 0, nloc_ = 0;
 
   VecH X_, bD_;              // block state; block D_s b_s (Dirichlet data)
   bool has_b_ = false;       // any Dirichlet data at all
-  Mat Dblock_ = nullptr;     // blockdiag(D_s L)
+  Mat Dblock_ = nullptr;     // blockdiag(scale_s M_s)
   Mat J_ = nullptr;          // shift I - Dblock
   PetscReal jac_shift_ = -1; // shift J_ holds (-1: stale)
   TS ts_ = nullptr;

@@ -19,11 +19,29 @@ struct Term {
 
 LaplacianMatrix::LaplacianMatrix(const Grid& grid, const Halo& halo, const Stencil& stencil,
                                  int nspecies, const std::vector<FaceValues>* dirichlet) {
+  assemble(
+      grid, halo,
+      [&](PetscInt, PetscInt, PetscInt, std::vector<CellTerm>& out) {
+        for (int t = 0; t < stencil.nterms; ++t)
+          out.push_back({{stencil.off[t][0], stencil.off[t][1], stencil.off[t][2]}, stencil.w[t]});
+      },
+      nspecies, dirichlet);
+}
+
+LaplacianMatrix::LaplacianMatrix(const Grid& grid, const Halo& halo, const CellTermsFn& terms,
+                                 int nspecies, const std::vector<FaceValues>* dirichlet) {
+  assemble(grid, halo, terms, nspecies, dirichlet);
+}
+
+void LaplacianMatrix::assemble(const Grid& grid, const Halo& halo, const CellTermsFn& cell_terms,
+                               int nspecies, const std::vector<FaceValues>* dirichlet) {
   const GridSpec& g = grid.spec();
   DM dm = grid.dm();
   MG_PETSC(DMSetMatType(dm, MATAIJ));
   MG_PETSC(DMCreateMatrix(dm, &L_));
-  MG_PETSC(MatSetOption(L_, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE));
+  // Preallocated for the DMDA's stencil (box when any operator has cross terms): a term
+  // outside it is a bug, reported instead of silently reallocating.
+  MG_PETSC(MatSetOption(L_, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
   const size_t ns = static_cast<size_t>(nspecies);
   for (size_t s = 0; s < ns; ++s)
     b_.push_back(grid.create_global());
@@ -62,16 +80,16 @@ LaplacianMatrix::LaplacianMatrix(const Grid& grid, const Halo& halo, const Stenc
   };
   std::vector<MatStencil> cols;
   std::vector<PetscScalar> vals;
+  std::vector<CellTerm> cterms;
   for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
     for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j)
       for (PetscInt i = ob.s[0]; i < ob.s[0] + ob.m[0]; ++i) {
         terms.clear();
         std::fill(consts.begin(), consts.end(), 0.0);
-        for (int t = 0; t < stencil.nterms; ++t) {
-          const PetscInt qi = i + stencil.off[t][0], qj = j + stencil.off[t][1],
-                         qk = k + stencil.off[t][2];
-          resolve(resolve, qi, qj, qk, stencil.w[t]);
-        }
+        cterms.clear();
+        cell_terms(i, j, k, cterms);
+        for (const CellTerm& ct : cterms)
+          resolve(resolve, i + ct.off[0], j + ct.off[1], k + ct.off[2], ct.w);
         MatStencil row{};
         row.i = i, row.j = j, row.k = k;
         cols.clear();

@@ -11,6 +11,7 @@
 #include "grid/halo.hpp"
 #include "operators/stencil.hpp"
 
+#include <functional>
 #include <petscmat.h>
 #include <vector>
 
@@ -18,7 +19,19 @@ namespace morphogen {
 
 class LaplacianMatrix {
 public:
+  // One stencil term of a cell: neighbour offset and weight.
+  struct CellTerm {
+    int off[3];
+    double w;
+  };
+  // Terms of owned cell (i, j, k) (appended to `out`, which arrives empty).
+  using CellTermsFn = std::function<void(PetscInt, PetscInt, PetscInt, std::vector<CellTerm>&)>;
+
   LaplacianMatrix(const Grid& grid, const Halo& halo, const Stencil& stencil, int nspecies,
+                  const std::vector<FaceValues>* dirichlet);
+  // A variable stencil (a diffusion operator's weights per cell); b for the nspecies Dirichlet
+  // value sets in `dirichlet` (may be null).
+  LaplacianMatrix(const Grid& grid, const Halo& halo, const CellTermsFn& terms, int nspecies,
                   const std::vector<FaceValues>* dirichlet);
   ~LaplacianMatrix() {
     if (L_) (void)MatDestroy(&L_);
@@ -30,6 +43,9 @@ public:
   Vec b(int species) const { return b_[species]; }
 
 private:
+  void assemble(const Grid& grid, const Halo& halo, const CellTermsFn& terms, int nspecies,
+                const std::vector<FaceValues>* dirichlet);
+
   Mat L_ = nullptr;
   std::vector<VecH> b_;
 };

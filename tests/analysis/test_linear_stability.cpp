@@ -22,6 +22,8 @@
 // Tolerances are stated per check; the refined k is good to ~1e-8 relative (golden section on a
 // quadratic maximum), closed-form quantities to ~1e-12.
 #include "analysis/linear_stability.hpp"
+#include "core/user_error.hpp"
+#include "operators/stencil.hpp"
 
 #include <gtest/gtest.h>
 
@@ -599,6 +601,376 @@ TEST(Summary, DefaultModelsOneLine) {
     EXPECT_FALSE(s.empty());
     EXPECT_EQ(s.find('\n'), std::string::npos) << m.name;
   }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Per-species (anisotropic) operators.
+//
+// A tensor Sigma on a 3x3 box (the symbol of the header): centre -2 S11/hx^2 - 2 S22/hy^2, x
+// neighbours S11/hx^2, y neighbours S22/hy^2, corners +-S12 / (2 hx hy) (+ on the (1, 1)
+// diagonal). Continuous theory, A(k) = J - diag(k^T S_s k): along a unit direction e the problem
+// is the isotropic one with D_s' = e^T S_s e. For a 2 x 2 system A = J - kappa^2 diag(Da', Db')
+// = J - kappa'^2 diag(1, Db'/Da') with kappa'^2 = Da' kappa^2, so the largest growth along e
+// depends only on rho(e) = Db'/Da' (and grows with it for Turk's activator-inhibitor J), and the
+// fastest |k| is kappa'_f(rho) / sqrt(Da'). In particular:
+//   * one tensor shared by both species (S_s = D_s Sigma): rho = Db/Da in every direction, the
+//     same maximum growth everywhere (a tie: the analysis keeps opt.direction), and the fastest
+//     |k| along e is k_iso / sqrt(e^T Sigma e), longest along the eigenvector of Sigma's SMALLER
+//     eigenvalue;
+//   * isotropic activator Da I and inhibitor Db Sigma: rho(e) = (Db/Da) e^T Sigma e, largest
+//     along the eigenvector of Sigma's LARGER eigenvalue: the fastest direction, with the growth
+//     and k of the isotropic problem with D' = (Da, Db lambda_max).
+
+SpeciesOperator scaled_stencil(const std::string& name, int dim, const std::array<double, 3>& h,
+                               double D) {
+  Stencil st;
+  EXPECT_TRUE(make_stencil(name, dim, h.data(), st));
+  SpeciesOperator op;
+  for (int t = 0; t < st.nterms; ++t) {
+    op.off.push_back(st.off[t]);
+    op.w.push_back(D * st.w[t]);
+  }
+  return op;
+}
+
+struct Tensor2 {
+  double s11, s22, s12;
+};
+// D R(theta) diag(l1, l2) R(theta)^T: l1 along (cos theta, sin theta).
+Tensor2 rotated(double D, double l1, double l2, double theta) {
+  const double c = std::cos(theta), s = std::sin(theta);
+  return {D * (l1 * c * c + l2 * s * s), D * (l1 * s * s + l2 * c * c), D * (l1 - l2) * c * s};
+}
+SpeciesOperator box_operator(const Tensor2& S, double hx, double hy) {
+  SpeciesOperator op;
+  auto add = [&](int dx, int dy, double w) {
+    op.off.push_back({dx, dy, 0});
+    op.w.push_back(w);
+  };
+  add(0, 0, -2 * S.s11 / (hx * hx) - 2 * S.s22 / (hy * hy));
+  add(-1, 0, S.s11 / (hx * hx));
+  add(1, 0, S.s11 / (hx * hx));
+  add(0, -1, S.s22 / (hy * hy));
+  add(0, 1, S.s22 / (hy * hy));
+  const double c = S.s12 / (2 * hx * hy);
+  add(1, 1, c);
+  add(-1, -1, c);
+  add(1, -1, -c);
+  add(-1, 1, -c);
+  return op;
+}
+double quad(const Tensor2& S, double ex, double ey) {
+  return S.s11 * ex * ex + 2 * S.s12 * ex * ey + S.s22 * ey * ey;
+}
+DiscreteGrid grid2(double h, long long n = 0) {
+  DiscreteGrid g;
+  g.h = {h, h, 1};
+  g.n = {n, n, 1};
+  return g;
+}
+double angle_diff(double a, double b) { // modulo pi
+  double d = std::fmod(std::abs(a - b), kPi);
+  return std::min(d, kPi - d);
+}
+
+TEST(SpeciesOperators, BoxSymbolIsTheTensorFormula) {
+  // operator_q of the box stencil equals the header's formula (1e-13 relative).
+  const Tensor2 S = rotated(0.3, 2, 0.5, kPi / 6);
+  const double hx = 0.5, hy = 0.25;
+  const auto op = box_operator(S, hx, hy);
+  for (const auto& k : {std::array<double, 3>{0.3, 0.7, 0}, {-1.1, 2.5, 0}, {4, -6, 0}}) {
+    const double want = S.s11 * 4 * std::pow(std::sin(k[0] * hx / 2), 2) / (hx * hx) +
+                        S.s22 * 4 * std::pow(std::sin(k[1] * hy / 2), 2) / (hy * hy) +
+                        2 * S.s12 * std::sin(k[0] * hx) * std::sin(k[1] * hy) / (hx * hy);
+    EXPECT_LT(rel(operator_q(op, {hx, hy, 1}, k), want), 1e-13);
+  }
+}
+
+TEST(SpeciesOperators, DTimesGridStencilReproducesGridResultsExactly) {
+  // Turk's D = (1/16, 1/4) are powers of two, so D_s * w_t is exact and the per-species
+  // symbols are bit for bit D_s q: every result equals the analysis without operators (the
+  // direction search ties and keeps opt.direction). At the defaults (marginal) and 0.1 % above
+  // (Turing-unstable, with a band); 5pt at h = 1 and 0.5 along x and the diagonal, 9pt.
+  const auto& m = model("turing");
+  const auto D = default_diffusion(m);
+  ASSERT_EQ(D, (std::vector<double>{1.0 / 16, 1.0 / 4}));
+  struct Case {
+    const char* stencil;
+    double h;
+    std::array<double, 3> dir;
+  };
+  for (const auto& p : {default_params(m), std::vector<double>{12 * 1.001, 16, 1.0 / 128}})
+    for (const Case& c : {Case{"5pt", 1, {1, 0, 0}}, Case{"5pt", 0.5, {1, 0, 0}},
+                          Case{"5pt", 1, {1, 1, 0}}, Case{"9pt", 1, {1, 0, 0}}}) {
+      StabilityOptions o;
+      o.grid = grid2(c.h, 64);
+      o.grid->stencil = c.stencil;
+      o.direction = c.dir;
+      const auto g = analyse(m, p, D, o);
+      for (int s = 0; s < 2; ++s)
+        o.operators.push_back(scaled_stencil(c.stencil, 2, o.grid->h, D[s]));
+      const auto r = analyse(m, p, D, o);
+      const std::string what =
+          std::string(c.stencil) + " h " + std::to_string(c.h) + " alpha " + std::to_string(p[0]);
+      EXPECT_EQ(r.operators.size(), 2u);
+      EXPECT_EQ(r.k_fastest, g.k_fastest) << what;
+      EXPECT_EQ(r.growth_fastest, g.growth_fastest) << what;
+      EXPECT_EQ(r.frequency_fastest, g.frequency_fastest) << what;
+      EXPECT_EQ(r.wavelength_fastest, g.wavelength_fastest) << what;
+      EXPECT_EQ(r.stable_homogeneous, g.stable_homogeneous) << what;
+      EXPECT_EQ(r.turing_unstable, g.turing_unstable) << what;
+      EXPECT_EQ(r.marginal, g.marginal) << what;
+      EXPECT_EQ(r.hopf, g.hopf) << what;
+      EXPECT_EQ(r.oscillatory_fastest, g.oscillatory_fastest) << what;
+      EXPECT_EQ(r.has_band, g.has_band) << what;
+      EXPECT_EQ(r.k_lo, g.k_lo) << what;
+      EXPECT_EQ(r.k_hi, g.k_hi) << what;
+      EXPECT_EQ(r.band_open, g.band_open) << what;
+      EXPECT_EQ(r.k_max, g.k_max) << what;
+      ASSERT_EQ(r.curve.size(), g.curve.size());
+      for (size_t i = 0; i < r.curve.size(); ++i)
+        ASSERT_EQ(r.curve[i].growth, g.curve[i].growth) << what << " sample " << i;
+      EXPECT_EQ(r.direction, g.direction) << what;
+      EXPECT_EQ(r.k_vector_fastest, g.k_vector_fastest) << what;
+      EXPECT_NEAR(r.direction_fastest, c.dir[1] > 0 ? kPi / 4 : 0, 1e-15) << what;
+      EXPECT_EQ(g.turing_unstable, p[0] > 12) << what;
+      // growth_at_k with operators = growth_at_q of the grid symbol (exact).
+      for (const auto& k : {std::array<double, 3>{0.3, 0.1, 0}, {0.2, -0.25, 0}}) {
+        const auto a = growth_at_k(r, k), b = growth_at_q(g, laplacian_q(&*o.grid, k));
+        EXPECT_EQ(a.growth, b.growth);
+        EXPECT_EQ(growth_at_k(g, k).growth, b.growth);
+      }
+      // The allowed modes (a different evaluation of the symbol: round-off only). Both stencils
+      // are symmetric under each axis' reflection: no sign combinations are scanned.
+      const auto ma = fastest_allowed_mode(g, *o.grid), mb = fastest_allowed_mode(r, *o.grid);
+      EXPECT_EQ(mb.scanned, 33 * 33 - 1) << what;
+      EXPECT_EQ(mb.m[0] * mb.m[0] + mb.m[1] * mb.m[1], ma.m[0] * ma.m[0] + ma.m[1] * ma.m[1]);
+      EXPECT_NEAR(mb.growth, ma.growth, 1e-15) << what;
+      EXPECT_TRUE(std::isnan(mb.q));
+    }
+  // Brusselator (D not powers of two): the same to round-off.
+  const auto& b = model("brusselator");
+  StabilityOptions o;
+  o.grid = grid2(1);
+  const auto g = analyse(b, default_params(b), default_diffusion(b), o);
+  for (double Ds : default_diffusion(b))
+    o.operators.push_back(scaled_stencil("5pt", 2, o.grid->h, Ds));
+  const auto r = analyse(b, default_params(b), default_diffusion(b), o);
+  EXPECT_TRUE(r.turing_unstable);
+  EXPECT_EQ(r.direction, g.direction);
+  EXPECT_LT(rel(r.k_fastest, g.k_fastest), 1e-7);
+  EXPECT_LT(rel(r.growth_fastest, g.growth_fastest), 1e-12);
+  EXPECT_LT(rel(r.k_hi, g.k_hi), 1e-8);
+}
+
+TEST(SpeciesOperators, SharedRotatedTensorScalesTheFastestK) {
+  // Sigma = R(30 deg) diag(2, 0.5) R^T for both species (S_s = D_s Sigma), Turk's kinetics 1 %
+  // above threshold, h = 1/16 (k h ~ 0.03: the box symbol is the continuous one to ~1e-4).
+  // Along every direction e: the growth is the isotropic maximum, and the fastest |k| is
+  // k_iso / sqrt(e^T Sigma e) (2e-4 relative); over directions (1 deg apart) the fastest |k| is
+  // longest at 120 deg (the eigenvector of the smaller eigenvalue 0.5) and shortest at 30 deg.
+  const auto& m = model("turing");
+  const std::vector<double> p{12 * 1.01, 16, 1.0 / 128};
+  const auto D = default_diffusion(m);
+  const auto iso = analyse(m, p, D); // continuous, isotropic
+  ASSERT_TRUE(iso.turing_unstable);
+  const double theta = kPi / 6, h = 1.0 / 16;
+  const Tensor2 Sigma = rotated(1, 2, 0.5, theta);
+  StabilityOptions o;
+  o.grid = grid2(h);
+  for (double Ds : D)
+    o.operators.push_back(box_operator(rotated(Ds, 2, 0.5, theta), h, h));
+  o.directions = 0; // the curve along opt.direction
+  double kmax_dir = 0, kmin_dir = 0, kmax = 0, kmin = 1e300;
+  for (int deg = 0; deg < 180; ++deg) {
+    const double phi = deg * kPi / 180;
+    o.direction = {std::cos(phi), std::sin(phi), 0};
+    const auto r = analyse(m, p, D, o);
+    EXPECT_TRUE(r.turing_unstable);
+    EXPECT_NEAR(r.direction_fastest, phi, 1e-14);
+    EXPECT_LT(rel(r.growth_fastest, iso.growth_fastest), 1e-4) << deg;
+    const double want = iso.k_fastest / sqrt(quad(Sigma, o.direction[0], o.direction[1]));
+    EXPECT_LT(rel(r.k_fastest, want), 2e-4) << deg;
+    if (r.k_fastest > kmax) kmax = r.k_fastest, kmax_dir = deg;
+    if (r.k_fastest < kmin) kmin = r.k_fastest, kmin_dir = deg;
+  }
+  EXPECT_EQ(kmax_dir, 120);
+  EXPECT_EQ(kmin_dir, 30);
+  EXPECT_LT(rel(kmax / kmin, 2.0), 1e-3); // sqrt(2 / 0.5)
+  // With the direction search: the maximum growth is the same in every direction (a tie to
+  // round-off, also on the grid: sigma depends on k only through the shared symbol), so the
+  // analysis keeps opt.direction, at its own fastest |k|.
+  o.directions = 180;
+  o.direction = {0, 1, 0};
+  const auto r = analyse(m, p, D, o);
+  EXPECT_NEAR(r.direction_fastest, kPi / 2, 1e-15);
+  EXPECT_LT(rel(r.k_fastest, iso.k_fastest / sqrt(Sigma.s22)), 2e-4);
+  EXPECT_NEAR(r.k_vector_fastest[1], r.k_fastest, 1e-15);
+}
+
+TEST(SpeciesOperators, AnisotropicInhibitorSetsTheFastestDirection) {
+  // Isotropic activator (Da I, the 5pt stencil), inhibitor Db R(theta) diag(1.5, 0.5) R^T, Turk's
+  // defaults (on the isotropic threshold, rho = 4): rho(e) = 4 e^T Sigma e is 6 along theta
+  // (Turing-unstable) and 2 across it (stable). The direction search finds theta (0.01 deg) with
+  // the growth and |k| of the isotropic continuous problem with D' = (Da, 1.5 Db) (1e-4, h = 1/16),
+  // for theta = 30 and -30 deg (reported as 150); k_vector_fastest has the matching signs.
+  const auto& m = model("turing");
+  const auto p = default_params(m);
+  const auto D = default_diffusion(m);
+  const auto cont = analyse(m, p, {D[0], 1.5 * D[1]});
+  ASSERT_TRUE(cont.turing_unstable);
+  const double h = 1.0 / 16;
+  for (double theta : {kPi / 6, -kPi / 6}) {
+    StabilityOptions o;
+    o.grid = grid2(h);
+    o.operators = {scaled_stencil("5pt", 2, o.grid->h, D[0]),
+                   box_operator(rotated(D[1], 1.5, 0.5, theta), h, h)};
+    const auto r = analyse(m, p, D, o);
+    const double want = theta > 0 ? theta : theta + kPi;
+    EXPECT_TRUE(r.turing_unstable) << summary(r);
+    EXPECT_LT(angle_diff(r.direction_fastest, want), 0.01 * kPi / 180)
+        << r.direction_fastest * 180 / kPi;
+    EXPECT_LT(rel(r.growth_fastest, cont.growth_fastest), 1e-4);
+    EXPECT_LT(rel(r.k_fastest, cont.k_fastest), 1e-4);
+    EXPECT_NEAR(std::hypot(r.k_vector_fastest[0], r.k_vector_fastest[1]), r.k_fastest, 1e-15);
+    EXPECT_GT(r.k_vector_fastest[0] * r.k_vector_fastest[1] * theta, 0); // ky's sign
+    EXPECT_TRUE(contains(summary(r), theta > 0 ? "direction 30 deg" : "direction 150 deg"))
+        << summary(r);
+    // The curve is along the fastest direction: its samples match growth_at_k there.
+    const auto& c = r.curve[r.curve.size() / 3];
+    EXPECT_EQ(growth_at_k(r, {c.k * r.direction[0], c.k * r.direction[1], 0}).growth, c.growth);
+    // Across theta (rho = 2) it is stable: the analysis along that direction alone.
+    o.directions = 0;
+    o.direction = {-std::sin(theta), std::cos(theta), 0};
+    const auto across = analyse(m, p, D, o);
+    EXPECT_FALSE(across.turing_unstable);
+    EXPECT_LT(across.growth_fastest, 0);
+  }
+}
+
+TEST(SpeciesOperators, FastestAllowedModeScansTheSignsOfCrossTerms) {
+  // The anisotropic inhibitor above on a periodic 128^2 grid, h = 1/2: the fastest allowed mode
+  // has kx ky of the sign of theta (continuous theory: the fastest direction is theta; across it
+  // the system is stable). Modes with m_d >= 0 only would miss theta = -30 deg altogether. The
+  // scan covers (n/2 + 1)^2 - 1 modes plus (n/2 - 1)^2 with ky negated, and its result is the
+  // brute-force maximum of growth_at_k over all allowed (kx, ky), either sign (1e-15).
+  const auto& m = model("turing");
+  const auto p = default_params(m);
+  const auto D = default_diffusion(m);
+  const double h = 0.5;
+  const long long n = 128;
+  const DiscreteGrid grid = grid2(h, n);
+  for (double theta : {kPi / 6, -kPi / 6}) {
+    StabilityOptions o;
+    o.grid = grid;
+    o.operators = {scaled_stencil("5pt", 2, grid.h, D[0]),
+                   box_operator(rotated(D[1], 1.5, 0.5, theta), h, h)};
+    const auto r = analyse(m, p, D, o);
+    const auto best = fastest_allowed_mode(r, grid);
+    EXPECT_EQ(best.scanned, (n / 2 + 1) * (n / 2 + 1) - 1 + (n / 2 - 1) * (n / 2 - 1));
+    EXPECT_GT(best.m[0], 0);
+    EXPECT_GT(best.m[1] * theta, 0) << "m = (" << best.m[0] << ", " << best.m[1] << ")";
+    EXPECT_GT(best.k[1] * theta, 0);
+    EXPECT_GT(best.growth, 0);
+    // Near the fastest direction and |k| (the allowed modes are 2 pi / 64 apart).
+    EXPECT_LT(angle_diff(std::atan2(best.k[1], best.k[0]), r.direction_fastest), 0.15);
+    EXPECT_LT(rel(best.k_abs, r.k_fastest), 0.15);
+    EXPECT_LE(best.growth, r.growth_fastest);
+    const auto ks = allowed_wavenumbers(grid, 0);
+    double brute = -1e300, brute_pos = -1e300;
+    for (double a : ks)
+      for (double b : ks)
+        if (a > 0 || b > 0) {
+          brute = std::max(brute, growth_at_k(r, {a, b, 0}).growth);
+          brute = std::max(brute, growth_at_k(r, {a, -b, 0}).growth);
+          brute_pos = std::max(brute_pos, growth_at_k(r, {a, b, 0}).growth);
+        }
+    EXPECT_NEAR(best.growth, brute, 1e-15);
+    EXPECT_NEAR(growth_at_k(r, best.k).growth, best.growth, 1e-15);
+    if (theta < 0) {
+      EXPECT_LT(brute_pos, 0.5 * best.growth); // the m >= 0 quadrant is slower
+    }
+  }
+}
+
+TEST(SpeciesOperators, FastestAllowedModeSignsIn3D) {
+  // 3-D operators with xy and yz cross terms (a 3x3x3 box) and kinetics unstable along a
+  // skew direction: the scan (signs up to k ~ -k) equals the brute-force maximum over every
+  // allowed (+-kx, +-ky, +-kz) of a 12 x 10 x 8 grid, periodic and zero-flux axes mixed.
+  const double J[4] = {3.0 / 8, 4.0 / 8, -4.0 / 8, -4.0 / 8};
+  const double D[2] = {1.0 / 16, 1.0 / 2};
+  DiscreteGrid grid;
+  grid.dim = 3;
+  grid.h = {1, 0.8, 1.2};
+  grid.n = {12, 10, 8};
+  grid.periodic = {true, false, true};
+  auto op3 = [&](double Ds, double cxy, double cyz) {
+    SpeciesOperator op = scaled_stencil("7pt", 3, grid.h, Ds);
+    auto add = [&](int a, int b, int c, double w) {
+      op.off.push_back({a, b, c});
+      op.w.push_back(w);
+      op.off.push_back({-a, -b, -c});
+      op.w.push_back(w);
+    };
+    add(1, 1, 0, cxy), add(1, -1, 0, -cxy), add(0, 1, 1, cyz), add(0, 1, -1, -cyz);
+    return op;
+  };
+  StabilityOptions o;
+  o.grid = grid;
+  o.operators = {op3(D[0], 0, 0), op3(D[1], 0.08, -0.05)};
+  const auto r = analyse_jacobian(2, J, D, o);
+  const auto best = fastest_allowed_mode(r, grid);
+  std::array<std::vector<double>, 3> ks;
+  for (int d = 0; d < 3; ++d)
+    ks[d] = allowed_wavenumbers(grid, d);
+  double brute = -1e300, brute_pos = -1e300;
+  for (double a : ks[0])
+    for (double b : ks[1])
+      for (double c : ks[2])
+        for (int sg = 0; sg < 8; ++sg)
+          if (a > 0 || b > 0 || c > 0) {
+            const double g =
+                growth_at_k(r, {sg & 1 ? -a : a, sg & 2 ? -b : b, sg & 4 ? -c : c}).growth;
+            brute = std::max(brute, g);
+            if (sg == 0) brute_pos = std::max(brute_pos, g);
+          }
+  EXPECT_NEAR(best.growth, brute, 1e-15);
+  EXPECT_LT(brute_pos, brute - 1e-3); // the signs matter here
+  EXPECT_NEAR(growth_at_k(r, best.k).growth, best.growth, 1e-15);
+  EXPECT_GT(best.growth, 0);
+  EXPECT_GE(best.m[0], 0);
+  // Without cross terms every sign gives the same symbol: modes with m_d >= 0 only.
+  o.operators = {op3(D[0], 0, 0), op3(D[1], 0, 0)};
+  EXPECT_EQ(fastest_allowed_mode(analyse_jacobian(2, J, D, o), grid).scanned, 7 * 10 * 5 - 1);
+}
+
+TEST(SpeciesOperators, BadOperatorsAreRejected) {
+  const double J[4] = {3.0 / 128, 4.0 / 128, -4.0 / 128, -4.0 / 128};
+  const double D[2] = {1.0 / 16, 1.0 / 4};
+  StabilityOptions o;
+  o.grid = grid2(1);
+  o.directions = 0;
+  const auto good = box_operator(rotated(1, 2, 0.5, 0.3), 1, 1);
+  o.operators = {good};
+  EXPECT_THROW(analyse_jacobian(2, J, D, o), UserError); // one operator for two species
+  auto asym = good;
+  asym.w[5] += 0.1, asym.w[0] -= 0.1; // (1, 1) no longer equals (-1, -1)
+  o.operators = {good, asym};
+  EXPECT_THROW(analyse_jacobian(2, J, D, o), UserError);
+  auto leaky = good;
+  leaky.w[0] -= 0.1; // sum w != 0
+  o.operators = {good, leaky};
+  EXPECT_THROW(analyse_jacobian(2, J, D, o), UserError);
+  auto deep = good;
+  deep.off.push_back({0, 0, 1}), deep.off.push_back({0, 0, -1});
+  deep.w.push_back(0), deep.w.push_back(0); // a z offset in 2-D
+  o.operators = {good, deep};
+  EXPECT_THROW(analyse_jacobian(2, J, D, o), UserError);
+  o.operators = {good, good};
+  const auto r = analyse_jacobian(2, J, D, o);
+  EXPECT_THROW(growth_at_q(r, 0.1), UserError); // no single q
+  o.grid.reset();
+  EXPECT_THROW(analyse_jacobian(2, J, D, o), UserError); // no spacings
 }
 
 } // namespace

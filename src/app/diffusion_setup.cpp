@@ -1,0 +1,197 @@
+#include "app/diffusion_setup.hpp"
+
+#include "core/collective_error.hpp"
+#include "core/user_error.hpp"
+#include "fields/field_fill.hpp"
+#include "fields/value_spec.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace morphogen {
+
+namespace {
+
+constexpr double kMaxReal = std::numeric_limits<double>::max();
+
+struct TensorKeys {
+  std::vector<std::string> keys; // option names
+  std::vector<std::string> defs;
+  bool components = false;
+};
+
+// The option names of species `name`'s tensor: the per-species ones if any is set.
+TensorKeys tensor_keys(const Options& opt, int dim, const std::string& name) {
+  const std::vector<std::string> principal =
+      dim == 2 ? std::vector<std::string>{"theta", "l1", "l2"}
+               : std::vector<std::string>{"theta", "phi", "l1", "l2", "l3"};
+  const std::vector<std::string> comps =
+      dim == 2 ? std::vector<std::string>{"xx", "xy", "yy"}
+               : std::vector<std::string>{"xx", "xy", "xz", "yy", "yz", "zz"};
+  std::string prefix = "tensor_";
+  for (const auto* set : {&principal, &comps})
+    for (const auto& k : *set)
+      if (opt.is_set("tensor_" + name + "_" + k)) prefix = "tensor_" + name + "_";
+  TensorKeys tk;
+  for (const auto& k : comps)
+    tk.components |= opt.is_set(prefix + k);
+  for (const auto& k : tk.components ? comps : principal) {
+    tk.keys.push_back(prefix + k);
+    tk.defs.push_back(k == "theta" || k == "xy" || k == "xz" || k == "yz" ? "0"
+                      : k == "phi"                                         ? "pi/2"
+                                                                           : "1");
+  }
+  return tk;
+}
+
+// sigma components from principal values and angles (v: theta, l1, l2 or theta, phi, l1..l3).
+void principal_to_components(int dim, const double* v, double* s) {
+  const double c = std::cos(v[0]), sn = std::sin(v[0]);
+  if (dim == 2) {
+    s[0] = v[1] * c * c + v[2] * sn * sn;
+    s[1] = (v[1] - v[2]) * c * sn;
+    s[2] = v[1] * sn * sn + v[2] * c * c;
+    return;
+  }
+  const double sp = std::sin(v[1]), cp = std::cos(v[1]);
+  const double e1[3] = {c * sp, sn * sp, cp}, e2[3] = {-sn, c, 0.0};
+  const double e3[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                        e1[0] * e2[1] - e1[1] * e2[0]};
+  const int a[6] = {0, 0, 0, 1, 1, 2}, b[6] = {0, 1, 2, 1, 2, 2};
+  for (int q = 0; q < 6; ++q)
+    s[q] = v[2] * e1[a[q]] * e1[b[q]] + v[3] * e2[a[q]] * e2[b[q]] + v[4] * e3[a[q]] * e3[b[q]];
+}
+
+std::string cell_text(PetscInt i, PetscInt j, PetscInt k, int dim) {
+  return "(" + std::to_string(i) + "," + std::to_string(j) +
+         (dim == 3 ? "," + std::to_string(k) : std::string()) + ")";
+}
+
+// The isotropic D with the same centre weight as the mean-coefficient stencil (for a tensor
+// with equal spacing: its mean trace / dim).
+double mean_diagonal(const DiffusionOperator& op, const Grid& grid) {
+  const Stencil m = op.mean_stencil();
+  double centre = 0;
+  for (int t = 0; t < m.nterms; ++t)
+    if (m.off[t][0] == 0 && m.off[t][1] == 0 && m.off[t][2] == 0) centre = -m.w[t];
+  double iso = 0;
+  for (int d = 0; d < grid.dim(); ++d)
+    iso += 2.0 / (grid.spec().h(d) * grid.spec().h(d));
+  return centre / iso;
+}
+
+} // namespace
+
+bool read_tensor_choice(Options& opt, const std::string& name) {
+  const std::string all = opt.choice("diffusion", "iso", {"iso", "tensor"},
+                                     "diffusion of every species: iso (D_S, a number or a field) "
+                                     "or tensor (D_S times the -tensor_* tensor)");
+  return opt.choice("diffusion_" + name, all, {"iso", "tensor"},
+                    "diffusion of species " + name + " (overrides -diffusion)") == "tensor";
+}
+
+DiffusionSetup read_diffusion(Options& opt, const Grid& grid, const Halo& halo,
+                              const Stencil& stencil, const SpeciesInfo& si, bool tensor,
+                              std::uint64_t seed, const std::string& base_dir) {
+  const GridSpec& spec = grid.spec();
+  const int dim = grid.dim();
+  const std::string name = si.name;
+  const std::string dkey = "D_" + name;
+  ValueSpec D(dkey,
+              opt.string(dkey, format_double(si.D),
+                         "diffusion coefficient of " + name + " (" + si.doc +
+                             "): a number, or a field (expression, 'v +- a%', png(...))"),
+              spec, seed, base_dir);
+  if (D.uses_time())
+    throw UserError("-" + dkey + " " + D.text() + ": time-dependent diffusion is not supported");
+  DiffusionSetup out;
+  if (D.is_constant() && !tensor) {
+    const double v = D.constant_value();
+    if (!(v >= 0 && v <= kMaxReal))
+      throw UserError("-" + dkey + " " + D.text() + ": out of range, allowed [0, " +
+                      format_double(kMaxReal) + "]");
+    out.op = std::make_unique<DiffusionOperator>(grid, stencil, v);
+    out.D_mean = v;
+    return out;
+  }
+  const Box& ob = grid.owned();
+  const size_t nghost = static_cast<size_t>(grid.ghosted().size());
+  if (!tensor) {
+    std::vector<std::vector<double>> c(1, std::vector<double>(nghost, 0.0));
+    fill_field(grid, D, c[0].data(), ArrayLayout::Ghosted, 0.0, kMaxReal);
+    out.op = std::make_unique<DiffusionOperator>(grid, halo, DiffusionScheme::IsotropicField,
+                                                 std::move(c));
+    out.D_mean = mean_diagonal(*out.op, grid);
+    return out;
+  }
+  const std::string scheme =
+      opt.choice("tensor_scheme", "second_order", {"second_order", "first_order"},
+                 "tensor discretisation: second_order (conservative, with the tensor-gradient "
+                 "terms; Sanderson eq. 17) or first_order (Witkin-Kass constant masks)");
+  const TensorKeys tk = tensor_keys(opt, dim, name);
+  std::vector<std::unique_ptr<ValueSpec>> vals;
+  for (size_t q = 0; q < tk.keys.size(); ++q) {
+    const std::string help =
+        tk.components ? "diffusion tensor component (times D_S); a value"
+        : tk.keys[q].find("theta") != std::string::npos
+            ? "angle of the first principal direction from the x axis (radians); a value"
+        : tk.keys[q].find("phi") != std::string::npos
+            ? "polar angle of the first principal direction from the z axis (radians)"
+            : "principal diffusivity (times D_S, > 0); a value";
+    vals.push_back(std::make_unique<ValueSpec>(
+        tk.keys[q], opt.string(tk.keys[q], tk.defs[q], help), spec, seed, base_dir));
+    if (vals.back()->uses_time())
+      throw UserError("-" + tk.keys[q] + " " + vals.back()->text() +
+                      ": time-dependent tensors are not supported");
+  }
+  const int nc = dim == 2 ? 3 : 6;
+  std::vector<std::vector<double>> c(static_cast<size_t>(nc), std::vector<double>(nghost, 0.0));
+  std::string err;
+  double v[6], s[6];
+  try {
+    for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2] && err.empty(); ++k)
+      for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1] && err.empty(); ++j)
+        for (PetscInt i = ob.s[0]; i < ob.s[0] + ob.m[0]; ++i) {
+          for (size_t q = 0; q < vals.size(); ++q)
+            v[q] = vals[q]->at_cell(i, j, k);
+          if (tk.components)
+            std::copy(v, v + nc, s);
+          else
+            principal_to_components(dim, v, s);
+          const double d = D.at_cell(i, j, k);
+          const bool pd = dim == 2 ? tensor_positive_definite<2>(s) : tensor_positive_definite<3>(s);
+          bool finite = std::isfinite(d);
+          for (int q = 0; q < nc; ++q)
+            finite = finite && std::isfinite(s[q]);
+          if (!pd || !finite || !(d >= 0)) {
+            std::ostringstream m;
+            m.precision(6);
+            m << (d >= 0 && std::isfinite(d) ? "-" + tk.keys[0] + ".." + tk.keys.back()
+                                             : "-" + dkey)
+              << ": the diffusion tensor of " << name << " must be positive definite with D_"
+              << name << " >= 0 at every cell; at cell " << cell_text(i, j, k, dim) << " D = " << d
+              << ", tensor (" << (tk.components ? "components" : "principal values") << ")";
+            for (size_t q = 0; q < vals.size(); ++q)
+              m << " " << tk.keys[q] << " = " << v[q];
+            err = m.str();
+            break;
+          }
+          const PetscInt gi = grid.local_index(i, j, k);
+          for (int q = 0; q < nc; ++q)
+            c[q][gi] = d * s[q];
+        }
+  } catch (const UserError& e) {
+    err = e.what();
+  }
+  throw_if_any(grid.comm(), err);
+  out.op = std::make_unique<DiffusionOperator>(
+      grid, halo,
+      scheme == "first_order" ? DiffusionScheme::TensorFirstOrder : DiffusionScheme::Tensor,
+      std::move(c));
+  out.D_mean = mean_diagonal(*out.op, grid);
+  return out;
+}
+
+} // namespace morphogen

@@ -1,0 +1,43 @@
+// The diffusion operators of all species as matrices with the boundary conditions folded in:
+//
+//   (K_s u)_c = scale_s ((M_s u)_c + b_s,c)
+//
+// equals the explicit operator (DiffusionOperator::apply_row on a halo-filled state). Species
+// with constant isotropic diffusion share one matrix, the run's Laplacian stencil, with
+// scale_s = D_s (so today's matrices and their round-off are kept); every other species has its
+// own matrix with the coefficients folded in (scale_s = 1). Used by the implicit diffusion
+// substep and by the TS integrator's implicit part.
+#pragma once
+
+#include "operators/diffusion_operator.hpp"
+#include "operators/laplacian_matrix.hpp"
+
+#include <memory>
+#include <vector>
+
+namespace morphogen {
+
+class OperatorMatrices {
+public:
+  // ops: one per species; dirichlet: one value set per species, or null.
+  OperatorMatrices(const Grid& grid, const Halo& halo, const Stencil& stencil,
+                   const std::vector<const DiffusionOperator*>& ops,
+                   const std::vector<FaceValues>* dirichlet);
+
+  int nspecies() const { return static_cast<int>(scale_.size()); }
+  Mat M(int s) const { return mat_[s]->L(); }
+  Vec b(int s) const { return mat_[s]->b(index_[s]); }
+  double scale(int s) const { return scale_[s]; }
+  // False where the operator is not symmetric (first-order tensor masks): CG does not apply.
+  bool symmetric(int s) const { return symmetric_[s]; }
+  bool has_dirichlet() const { return has_dirichlet_; }
+
+private:
+  std::vector<std::shared_ptr<LaplacianMatrix>> mat_;
+  std::vector<int> index_; // which of the matrix's b vectors is species s's
+  std::vector<double> scale_;
+  std::vector<bool> symmetric_;
+  bool has_dirichlet_ = false;
+};
+
+} // namespace morphogen
