@@ -3,6 +3,7 @@
 #include "core/collective_error.hpp"
 #include "core/user_error.hpp"
 #include "fields/field_fill.hpp"
+#include "fields/surface_metric.hpp"
 #include "fields/value_spec.hpp"
 
 #include <algorithm>
@@ -82,6 +83,30 @@ double mean_diagonal(const DiffusionOperator& op, const Grid& grid) {
   return centre / iso;
 }
 
+// -surface_x/y/z: the parametric surface x(u, v) the texture is grown for (2-D).
+std::unique_ptr<SurfaceMap> read_surface(Options& opt, const GridSpec& spec) {
+  const char* axes[3] = {"surface_x", "surface_y", "surface_z"};
+  bool any = false;
+  for (const char* a : axes)
+    any = any || opt.is_set(a);
+  if (!any) {
+    for (const char* a : axes)
+      opt.known(a);
+    return nullptr;
+  }
+  if (spec.dim != 2)
+    throw UserError("-surface_x/-surface_y/-surface_z: the surface-metric correction is for 2-D "
+                    "runs (a parametric surface x(u, v))");
+  std::string e[3];
+  const char* defs[3] = {"u", "v", "0"};
+  for (int a = 0; a < 3; ++a)
+    e[a] = opt.string(axes[a], defs[a],
+                      std::string("parametric surface, ") + "xyz"[a] +
+                          " component as an expression of u, v (the grid's x, y), Lx, Ly: the "
+                          "tensor is corrected for the surface metric (Witkin-Kass section 4)");
+  return std::make_unique<SurfaceMap>(e[0], e[1], e[2], spec.L[0], spec.L[1]);
+}
+
 } // namespace
 
 bool read_tensor_choice(Options& opt, const std::string& name) {
@@ -147,6 +172,7 @@ DiffusionSetup read_diffusion(Options& opt, const Grid& grid, const Halo& halo,
                       ": time-dependent tensors are not supported");
   }
   const int nc = dim == 2 ? 3 : 6;
+  std::unique_ptr<SurfaceMap> surface = read_surface(opt, spec);
   std::vector<std::vector<double>> c(static_cast<size_t>(nc), std::vector<double>(nghost, 0.0));
   std::string err;
   double v[6], s[6];
@@ -160,6 +186,8 @@ DiffusionSetup read_diffusion(Options& opt, const Grid& grid, const Halo& halo,
             std::copy(v, v + nc, s);
           else
             principal_to_components(dim, v, s);
+          if (surface) // the tensor is meant on the surface: correct it for the map's metric
+            surface->corrected_tensor(grid.centre(0, i), grid.centre(1, j), s, s);
           const double d = D.at_cell(i, j, k);
           const bool pd = dim == 2 ? tensor_positive_definite<2>(s) : tensor_positive_definite<3>(s);
           bool finite = std::isfinite(d);

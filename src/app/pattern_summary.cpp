@@ -177,6 +177,18 @@ nlohmann::json stability_record(const Simulation& sim) {
   dg.stencil = sim.stencil().name;
   analysis::StabilityOptions so;
   so.grid = dg;
+  // Diffusion maps and tensors: each species' operator at the spatial-mean coefficients.
+  const bool mean_diffusion = !sim.all_constant_diffusion();
+  if (mean_diffusion)
+    for (const DiffusionOperator* op : sim.operators()) {
+      const Stencil st = op->mean_stencil();
+      analysis::SpeciesOperator so_op;
+      for (int t = 0; t < st.nterms; ++t) {
+        so_op.off.push_back({st.off[t][0], st.off[t][1], st.off[t][2]});
+        so_op.w.push_back(st.w[t]);
+      }
+      so.operators.push_back(std::move(so_op));
+    }
   try {
     int states = 0;
     const auto r = analyse_states(sim.model(), p, sim.diffusion(), so, &states);
@@ -196,6 +208,10 @@ nlohmann::json stability_record(const Simulation& sim) {
     }
     j["steady_states"] = states;
     if (!averaged.empty()) j["parameters_averaged"] = averaged;
+    if (mean_diffusion) {
+      j["diffusion_averaged"] = true; // analysed with the spatial-mean maps / tensors
+      j["direction_fastest_deg"] = num(r.direction_fastest * 180.0 / M_PI);
+    }
     return j;
   } catch (const UserError& e) {
     return {{"error", e.what()}};

@@ -180,7 +180,19 @@ void TsIntegrator::setup_ts(double dt) {
   MG_PETSC(SNESSetType(snes, SNESKSPONLY));
   KSP ksp;
   MG_PETSC(SNESGetKSP(snes, &ksp));
-  set_cg_icc(ksp);
+  bool symmetric = true;
+  for (int s = 0; s < ops_.nspecies(); ++s)
+    symmetric = symmetric && ops_.symmetric(s);
+  if (symmetric) {
+    set_cg_icc(ksp);
+  } else { // first-order tensor masks: a non-symmetric operator
+    int size = 1;
+    MPI_Comm_size(grid_.comm(), &size);
+    MG_PETSC(KSPSetType(ksp, KSPGMRES));
+    PC pc;
+    MG_PETSC(KSPGetPC(ksp, &pc));
+    MG_PETSC(PCSetType(pc, size == 1 ? PCILU : PCBJACOBI));
+  }
   MG_PETSC(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, 10000));
   MG_PETSC(TSSetFromOptions(ts_));
 
@@ -217,7 +229,13 @@ void TsIntegrator::setup_ts(double dt) {
   MG_PETSC(fill_jacobian(1.0 / dt));
   jac_shift_ = -1; // force a refresh on the first call
   MG_PETSC(KSPSetOperators(ksp, J_, J_));
-  icc_subblocks(ksp, "-sub_pc_type");
+  bool all_symmetric = true;
+  for (int s = 0; s < ops_.nspecies(); ++s)
+    all_symmetric = all_symmetric && ops_.symmetric(s);
+  if (all_symmetric)
+    icc_subblocks(ksp, "-sub_pc_type");
+  else
+    MG_PETSC(KSPSetUp(ksp));
 }
 
 // ---- PETSc callbacks: no exception may leave them -------------------------------------------
