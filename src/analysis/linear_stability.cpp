@@ -2,7 +2,7 @@
 #include "analysis/linear_stability.hpp"
 
 #include "core/user_error.hpp"
-#include "operators/stencil.hpp"
+#include "grid/stencil.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -581,7 +581,7 @@ StabilityResult analyse_jacobian(int n, const double* J, const double* D,
   return r;
 }
 
-StabilityResult analyse(const ModelEntry& entry, const std::vector<double>& params,
+StabilityResult analyse(const ModelInfo& entry, const std::vector<double>& params,
                         const std::vector<double>& D, const StabilityOptions& opt) {
   const int n = entry.nspecies;
   if (static_cast<int>(params.size()) != entry.nparams || static_cast<int>(D.size()) != n)
@@ -610,14 +610,14 @@ StabilityResult analyse(const ModelEntry& entry, const std::vector<double>& para
   return r;
 }
 
-std::vector<double> default_params(const ModelEntry& entry) {
+std::vector<double> default_params(const ModelInfo& entry) {
   std::vector<double> p(entry.nparams);
   for (int i = 0; i < entry.nparams; ++i)
     p[i] = entry.params[i].def;
   return p;
 }
 
-std::vector<double> default_diffusion(const ModelEntry& entry) {
+std::vector<double> default_diffusion(const ModelInfo& entry) {
   std::vector<double> D(entry.nspecies);
   for (int s = 0; s < entry.nspecies; ++s)
     D[s] = entry.species[s].D;
@@ -762,7 +762,7 @@ AllowedMode fastest_allowed_mode(const StabilityResult& r, const DiscreteGrid& g
   return best;
 }
 
-std::vector<std::vector<double>> find_steady_states(const ModelEntry& entry,
+std::vector<std::vector<double>> find_steady_states(const ModelInfo& entry,
                                                     const std::vector<double>& params,
                                                     const SteadySearch& search) {
   const int n = entry.nspecies;

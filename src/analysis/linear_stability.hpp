@@ -10,7 +10,7 @@
 //   continuous:   q = |k|^2
 //   5pt, 7pt:     q = sum_d (4 / h_d^2) sin^2(k_d h_d / 2)
 //   9pt:          q = (20 - 8 (cos t_x + cos t_y) - 4 cos t_x cos t_y) / (6 h^2),  t_d = k_d h
-// (computed from the stencil weights of operators/stencil.hpp, so it is the simulated operator).
+// (computed from the stencil weights of grid/stencil.hpp, so it is the simulated operator).
 // The growth rate of k is sigma(k) = max Re lambda(A(q(k))); with dt > 0 it is instead the rate
 // of the forward Euler map u <- (I + dt A) u, ln|1 + dt lambda| / dt (what the explicit
 // integrator does). The dispersion curve is sampled on k in [0, k_max] along a direction and its
@@ -47,7 +47,7 @@
 // e^T S_b e / e^T S_a e).
 #pragma once
 
-#include "app/model_registry.hpp"
+#include "models/model_info.hpp"
 #include "grid/grid.hpp"
 
 #include <array>
@@ -176,11 +176,11 @@ StabilityResult analyse_jacobian(int n, const double* J, const double* D,
 
 // Analysis of a model: params has entry.nparams values, D entry.nspecies. The state is
 // opt.u_star if given, else entry.steady_state (has_steady_state false if it reports none).
-StabilityResult analyse(const ModelEntry& entry, const std::vector<double>& params,
+StabilityResult analyse(const ModelInfo& entry, const std::vector<double>& params,
                         const std::vector<double>& D, const StabilityOptions& opt = {});
 
-std::vector<double> default_params(const ModelEntry& entry);
-std::vector<double> default_diffusion(const ModelEntry& entry);
+std::vector<double> default_params(const ModelInfo& entry);
+std::vector<double> default_diffusion(const ModelInfo& entry);
 
 // sigma and Im lambda of q for an analysed state (uses r's J, D, dt, eigensolver choice).
 // Isotropic case only (A = J - q diag(D)); throws if r has per-species operators.
@@ -218,7 +218,7 @@ struct SteadySearch {
   int points = 0;             // per species; 0: 65, 17, 9, 7 for 1, 2, 3, 4 species
   int max_it = 60;
 };
-std::vector<std::vector<double>> find_steady_states(const ModelEntry& entry,
+std::vector<std::vector<double>> find_steady_states(const ModelInfo& entry,
                                                     const std::vector<double>& params,
                                                     const SteadySearch& search = {});
 

@@ -265,11 +265,11 @@ void Simulation::read_model(Options& opt, const std::string& base_dir) {
   RowStencil rows;
   to_rows(stencil_, rows);
   const ExplicitIntegrator::RowFn fn =
-      model_->row_kernel(params_.any_field(), rows.nrows, rows.box);
+      model_->kernels.row_kernel(params_.any_field(), rows.nrows, rows.box);
   integrator_ = std::make_unique<ExplicitIntegrator>(
       *grid_, *halo_, fn, ns, stencil_, D_, floor_, params_, any_dirichlet ? &dirichlet_ : nullptr);
   if (!all_constant_diffusion())
-    integrator_->use_operators(operators(), model_->explicit_pre[params_.any_field() ? 1 : 0]);
+    integrator_->use_operators(operators(), model_->kernels.explicit_pre[params_.any_field() ? 1 : 0]);
   integrator_->update_ghosts(u_);
 }
 
@@ -362,7 +362,7 @@ void Simulation::read_time(Options& opt) {
     diffusion_ = std::make_unique<DiffusionSolver>(*grid_, *matrices_, species_, opt);
     diffusion_->prepare(dt_, set.theta);
     split_integrator_ = std::make_unique<SplitIntegrator>(
-        *grid_, model_->reaction_row[params_.any_field() ? 1 : 0], species_, params_, floor_,
+        *grid_, model_->kernels.reaction_row[params_.any_field() ? 1 : 0], species_, params_, floor_,
         sources_.get(), *diffusion_, set);
   }
 }

@@ -21,7 +21,7 @@
 #include "core/options.hpp"
 #include "grid/halo.hpp"
 #include "operators/operator_matrices.hpp"
-#include "operators/stencil.hpp"
+#include "grid/stencil.hpp"
 
 #include <memory>
 #include <petscksp.h>

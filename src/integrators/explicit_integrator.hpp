@@ -18,7 +18,7 @@
 #include "grid/halo.hpp"
 #include "integrators/explicit_kernel.hpp"
 #include "operators/diffusion_operator.hpp"
-#include "operators/stencil.hpp"
+#include "grid/stencil.hpp"
 
 #include <vector>
 

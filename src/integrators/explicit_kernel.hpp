@@ -1,6 +1,6 @@
 // Fused explicit Euler sweep over one row of cells (pure kernel: no PETSc, MPI, allocation).
 //
-// The Laplacian is given in row form (operators/stencil.hpp, RowStencil): NR grid rows
+// The Laplacian is given in row form (grid/stencil.hpp, RowStencil): NR grid rows
 // (row 0 is the cell's own row), each with three x-taps w[r][0..2] for x offsets -1, 0, +1.
 // For each cell i of the row and each species s:
 //   lap_s = sum_r ( w[r][0] u_s,r[i-1] + w[r][1] u_s,r[i] + w[r][2] u_s,r[i+1] )

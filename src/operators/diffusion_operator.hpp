@@ -14,7 +14,7 @@
 
 #include "grid/halo.hpp"
 #include "operators/diffusion_kernel.hpp"
-#include "operators/stencil.hpp"
+#include "grid/stencil.hpp"
 
 #include <vector>
 

@@ -9,7 +9,7 @@
 #pragma once
 
 #include "grid/halo.hpp"
-#include "operators/stencil.hpp"
+#include "grid/stencil.hpp"
 
 #include <functional>
 #include <petscmat.h>

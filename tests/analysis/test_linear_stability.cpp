@@ -22,8 +22,9 @@
 // Tolerances are stated per check; the refined k is good to ~1e-8 relative (golden section on a
 // quadratic maximum), closed-form quantities to ~1e-12.
 #include "analysis/linear_stability.hpp"
+#include "app/model_registry.hpp"
 #include "core/user_error.hpp"
-#include "operators/stencil.hpp"
+#include "grid/stencil.hpp"
 
 #include <gtest/gtest.h>
 

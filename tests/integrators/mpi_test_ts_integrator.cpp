@@ -61,7 +61,18 @@ struct Problem {
   std::unique_ptr<Halo> halo;
   Stencil stencil;
   std::vector<FaceValues> dirichlet;
-  std::unique_ptr<LaplacianMatrix> lap;
+  std::vector<std::unique_ptr<DiffusionOperator>> ops;
+  std::unique_ptr<OperatorMatrices> lap;
+  // The species' constant isotropic operators as matrices (dirichlet: may be null).
+  void build_matrices(const std::vector<double>& D, const std::vector<FaceValues>* dirichlet) {
+    ops.clear();
+    std::vector<const DiffusionOperator*> ptr;
+    for (double d : D) {
+      ops.push_back(std::make_unique<DiffusionOperator>(*grid, stencil, d));
+      ptr.push_back(ops.back().get());
+    }
+    lap = std::make_unique<OperatorMatrices>(*grid, *halo, stencil, ptr, dirichlet);
+  }
   ParamSet params;
   std::unique_ptr<SourceTerms> sources;
   std::vector<VecH> u;
@@ -129,8 +140,7 @@ std::unique_ptr<Problem> make_problem(MPI_Comm comm, const ProblemSpec& ps) {
             p->dirichlet[s].face[2 * d + side].assign(static_cast<size_t>(p->halo->face_size(d)),
                                                       ps.dirichlet.at(s));
   }
-  p->lap = std::make_unique<LaplacianMatrix>(*p->grid, *p->halo, p->stencil, ns,
-                                             any_dirichlet ? &p->dirichlet : nullptr);
+  p->build_matrices(ps.D, any_dirichlet ? &p->dirichlet : nullptr);
   const Box& ob = p->grid->owned();
   for (int q = 0; q < model->nparams; ++q) {
     p->params.names.emplace_back(model->params[q].name);
@@ -166,7 +176,7 @@ std::unique_ptr<Problem> make_problem(MPI_Comm comm, const ProblemSpec& ps) {
     VecRestoreArray(p->u.back(), &a);
   }
   const std::vector<double> floor = ps.floor.empty() ? std::vector<double>(ns, -kInf) : ps.floor;
-  p->ts = std::make_unique<TsIntegrator>(*p->grid, model->rates, species, p->params, ps.D, floor,
+  p->ts = std::make_unique<TsIntegrator>(*p->grid, model->rates, species, p->params, floor,
                                          *p->lap, p->sources.get(), ps.dt);
   return p;
 }
@@ -470,10 +480,11 @@ TEST(TsIntegrator, DirichletLinearSteadyState) {
   p->ts.reset();
   for (auto& f : p->dirichlet)
     std::fill(f.face[1].begin(), f.face[1].end(), 3.0);
-  p->lap = std::make_unique<LaplacianMatrix>(*p->grid, *p->halo, p->stencil, 2, &p->dirichlet);
-  p->ts = std::make_unique<TsIntegrator>(
-      *p->grid, find_model("turing")->rates, std::vector<std::string>{"a", "b"}, p->params, ps.D,
-      std::vector<double>{-kInf, -kInf}, *p->lap, nullptr, ps.dt);
+  p->build_matrices(ps.D, &p->dirichlet);
+  p->ts = std::make_unique<TsIntegrator>(*p->grid, find_model("turing")->rates,
+                                         std::vector<std::string>{"a", "b"}, p->params,
+                                         std::vector<double>{-kInf, -kInf}, *p->lap, nullptr,
+                                         ps.dt);
   p->run(100, ps.dt);
   for (int s = 0; s < 2; ++s)
     EXPECT_LT(p->max_error(s, [](double x, double) { return 1 + 2 * x / 16; }), 1e-8);

@@ -1,4 +1,4 @@
-#include "operators/stencil.hpp"
+#include "grid/stencil.hpp"
 
 namespace morphogen {
 

@@ -1,0 +1,6 @@
+// The BarkleyTurbulent model's kernels (see integrators/model_kernels.hpp).
+#include "integrators/model_kernels.hpp"
+
+namespace morphogen {
+template ModelKernels model_kernels<models::BarkleyTurbulent>();
+} // namespace morphogen

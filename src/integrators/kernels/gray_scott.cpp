@@ -1,0 +1,6 @@
+// The GrayScott model's kernels (see integrators/model_kernels.hpp).
+#include "integrators/model_kernels.hpp"
+
+namespace morphogen {
+template ModelKernels model_kernels<models::GrayScott>();
+} // namespace morphogen

@@ -1,0 +1,65 @@
+// The kernels instantiated from one reaction model: the fused explicit row sweep for each
+// stencil row layout and for scalar or per-cell parameters, the general explicit path's update
+// (diffusion precomputed) and the split integrator's per-cell reaction substep. Each model's
+// table is instantiated in its own translation unit (integrators/kernels/<model>.cpp, declared
+// `extern template` here), so adding a kernel variant does not grow one file's compile time.
+#pragma once
+
+#include "integrators/explicit_kernel.hpp"
+#include "integrators/reaction_kernel.hpp"
+#include "integrators/split_integrator.hpp"
+#include "models/all_models.hpp"
+
+#include <stdexcept>
+
+namespace morphogen {
+
+using ExplicitRowFn = void (*)(const ExplicitRow&);
+
+// Row layouts of the fused sweep (RowStencil): 5pt (3 star rows), 7pt (5 star rows),
+// 9pt (3 box rows).
+enum class RowLayout { Star3 = 0, Star5 = 1, Box3 = 2 };
+constexpr int kRowLayouts = 3;
+
+struct ModelKernels {
+  ExplicitRowFn explicit_row[2][kRowLayouts]; // [field_params][layout]
+  ExplicitRowFn explicit_pre[2];              // [field_params]
+  ReactionRowFn reaction_row[2];              // [field_params]
+
+  // The fused kernel of a row stencil; throws std::logic_error for a layout without one
+  // (callers check the stencil first: there are no null entries to call).
+  ExplicitRowFn row_kernel(bool field_params, int nrows, bool box) const {
+    const int idx = !box && nrows == 3 ? 0 : !box && nrows == 5 ? 1 : box && nrows == 3 ? 2 : -1;
+    if (idx < 0) throw std::logic_error("no fused explicit kernel for this stencil layout");
+    return explicit_row[field_params ? 1 : 0][idx];
+  }
+};
+
+template <class M> ModelKernels model_kernels() {
+  ModelKernels k{};
+  k.explicit_row[0][0] = &explicit_row<M, 3, false, false>;
+  k.explicit_row[0][1] = &explicit_row<M, 5, false, false>;
+  k.explicit_row[0][2] = &explicit_row<M, 3, true, false>;
+  k.explicit_row[1][0] = &explicit_row<M, 3, false, true>;
+  k.explicit_row[1][1] = &explicit_row<M, 5, false, true>;
+  k.explicit_row[1][2] = &explicit_row<M, 3, true, true>;
+  k.explicit_pre[0] = &explicit_row_pre<M, false>;
+  k.explicit_pre[1] = &explicit_row_pre<M, true>;
+  k.reaction_row[0] = &reaction_row<M, false>;
+  k.reaction_row[1] = &reaction_row<M, true>;
+  return k;
+}
+
+extern template ModelKernels model_kernels<models::Turing>();
+extern template ModelKernels model_kernels<models::GrayScott>();
+extern template ModelKernels model_kernels<models::GrayScottSims>();
+extern template ModelKernels model_kernels<models::Brusselator>();
+extern template ModelKernels model_kernels<models::GiererMeinhardt>();
+extern template ModelKernels model_kernels<models::Meinhardt>();
+extern template ModelKernels model_kernels<models::Schnakenberg>();
+extern template ModelKernels model_kernels<models::FitzHughNagumo>();
+extern template ModelKernels model_kernels<models::Barkley>();
+extern template ModelKernels model_kernels<models::BarkleyTurbulent>();
+extern template ModelKernels model_kernels<models::Oregonator>();
+
+} // namespace morphogen

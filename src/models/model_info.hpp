@@ -1,0 +1,50 @@
+// A model's runtime descriptor (species, parameters, kinetics) and the registry of all models by
+// name, built at compile time from the header-only model types in models/all_models.hpp. The
+// kernels instantiated from a model (explicit sweeps, reaction substeps) are the integrators'
+// business (app/model_registry.hpp adds them).
+#pragma once
+
+#include "models/all_models.hpp"
+#include "models/model.hpp"
+
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+namespace morphogen {
+
+struct ModelInfo {
+  const char* name;
+  const char* doc;
+  const char* reference;
+  int nspecies;
+  int nparams;
+  const SpeciesInfo* species;
+  const ParamInfo* params;
+  bool clamp_default;
+  void (*rates)(const double* u, const double* p, double* r);
+  void (*jacobian)(const double* u, const double* p, double* J);
+  bool (*steady_state)(const double* p, double* u);
+};
+
+template <class M> ModelInfo model_info() {
+  return {M::name,           M::doc,    M::reference,     M::nspecies,
+          M::nparams,        M::species.data(), M::params.data(), M::clamp_default,
+          &M::rates,         &M::jacobian, &M::steady_state};
+}
+
+namespace detail {
+template <class Tuple, size_t... I> std::vector<ModelInfo> model_infos(std::index_sequence<I...>) {
+  return {model_info<std::tuple_element_t<I, Tuple>>()...};
+}
+} // namespace detail
+
+// Every registered model, in AllModels order.
+inline const std::vector<ModelInfo>& model_infos() {
+  static const std::vector<ModelInfo> all = detail::model_infos<AllModels>(
+      std::make_index_sequence<std::tuple_size_v<AllModels>>{});
+  return all;
+}
+
+} // namespace morphogen
