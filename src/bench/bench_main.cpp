@@ -2,12 +2,15 @@
 // against a STREAM triad measured in the same process, printed as the fraction of the memory
 // bandwidth roofline (32 bytes per 2-species cell-update in double: read u, v; write u, v).
 // Also times the halo-only update used by the integrator against PETSc's full
-// DMGlobalToLocal copy. Runs on any number of ranks (aggregate figures). Last line:
+// DMGlobalToLocal copy, and the general explicit path (diffusion tensor, diffusion map) with its
+// own bytes per update and its ratio to the fused path. Runs on any number of ranks (aggregate
+// figures). Last line:
 //   roofline_fraction=<2-D fraction>
 #include "app/simulation.hpp"
 #include "core/user_error.hpp"
 
 #include <algorithm>
+#include <tuple>
 #include <cstdio>
 #include <vector>
 
@@ -43,7 +46,16 @@ struct Result {
   double cups = 0, halo_s = 0, g2l_s = 0;
 };
 
-Result bench_explicit(MPI_Comm comm, Options& opt, const std::string& n, int steps) {
+// Diffusion options of the general-path cases (cleared before each case).
+const char* const kDiffusionKeys[] = {"-diffusion", "-tensor_theta", "-tensor_l1", "-tensor_l2",
+                                      "-D_a"};
+
+Result bench_explicit(MPI_Comm comm, Options& opt, const std::string& n, int steps,
+                      const std::vector<std::pair<std::string, std::string>>& extra = {}) {
+  for (const char* k : kDiffusionKeys)
+    MG_PETSC(PetscOptionsClearValue(nullptr, k));
+  for (auto& [k, v] : extra)
+    MG_PETSC(PetscOptionsSetValue(nullptr, k.c_str(), v.c_str()));
   const std::pair<const char*, const char*> opts[] = {
       {"-model", "gray_scott"},
       {"-grid_n", n.c_str()},
@@ -153,6 +165,26 @@ int run(MPI_Comm comm) {
   report("2d", "1024x1024", r2);
   const Result r3 = bench_explicit(comm, opt, "128,128,128", static_cast<int>(steps3));
   report("3d", "128x128x128", r3);
+  // The general path (diffusion from per-species operators, then the reaction, row by row):
+  // a rotated tensor for both species (reads 3 dual-cell tensor components per species: 80
+  // bytes per update) and a diffusion map for one species (40 bytes).
+  const std::vector<std::tuple<const char*, int, std::vector<std::pair<std::string, std::string>>>>
+      general = {{"2d_tensor",
+                  80,
+                  {{"-diffusion", "tensor"},
+                   {"-tensor_theta", "0.5"},
+                   {"-tensor_l1", "1.5"},
+                   {"-tensor_l2", "0.5"}}},
+                 {"2d_map", 40, {{"-D_a", "1e-5*(1 + 0.5*x/Lx)"}}}};
+  for (const auto& [tag, bytes, extra] : general) {
+    const Result rg = bench_explicit(comm, opt, "1024,1024", static_cast<int>(steps2), extra);
+    PetscPrintf(comm,
+                "explicit_%s grid=1024x1024 model=gray_scott bytes_per_update=%d "
+                "cell_updates_per_s=%.4e fraction=%.3f vs_fused_2d=%.3f\n",
+                tag, bytes, rg.cups, rg.cups / (bw / bytes), rg.cups / r2.cups);
+  }
+  for (const char* k : kDiffusionKeys)
+    MG_PETSC(PetscOptionsClearValue(nullptr, k));
   if (with_split) {
     // The explicit step for comparison: same model and grid as the split runs.
     const double explicit_s = 1024.0 * 1024.0 / r2.cups;

@@ -191,10 +191,8 @@ template <int Dim> MG_HD inline bool tensor_positive_definite(const double* s) {
 // d_b(X) the one-sided difference of X along b on Q's side. cq[q] points at the cell's entry of
 // the dual-cell tensors (component q), indexed by each dual cell's lower cell.
 // The 2-D case written out (the same sums; the generic loop below does not vectorise).
-MG_HD inline double tensor_divergence_2d(const double* u, const double* const* cq, long sy,
-                                         const double* inv_h) {
-  const double *X = cq[0], *Y = cq[1], *Z = cq[2];
-  const double hx = inv_h[0], hy = inv_h[1];
+MG_HD inline double tensor_divergence_2d(const double* u, const double* X, const double* Y,
+                                         const double* Z, long sy, double hx, double hy) {
   const double uP = u[0], uE = u[1], uW = u[-1], uN = u[sy], uS = u[-sy];
   const double uNE = u[sy + 1], uNW = u[sy - 1], uSE = u[1 - sy], uSW = u[-1 - sy];
   const long sw = -1 - sy; // dual cell below-left
@@ -213,7 +211,7 @@ MG_HD inline double tensor_divergence_2d(const double* u, const double* const* c
 template <int Dim>
 MG_HD inline double tensor_divergence(const double* u, const double* const* cq, const long* st,
                                       const double* inv_h) {
-  if constexpr (Dim == 2) return tensor_divergence_2d(u, cq, st[1], inv_h);
+  if constexpr (Dim == 2) return tensor_divergence_2d(u, cq[0], cq[1], cq[2], st[1], inv_h[0], inv_h[1]);
   using T = TensorLayout<Dim>;
   constexpr int NF = 1 << (Dim - 1); // dual cells per face
   double div = 0.0;
@@ -275,6 +273,17 @@ template <int Dim, DiffusionScheme S>
 inline void diffusion_row(int n, const double* const* coef, const long* st, const double* u,
                           const double* inv_h, double* out) {
   constexpr int NC = S == DiffusionScheme::IsotropicField ? 1 : TensorLayout<Dim>::nc;
+  if constexpr (Dim == 2 && S == DiffusionScheme::Tensor) {
+    const double* __restrict__ X = coef[0];
+    const double* __restrict__ Y = coef[1];
+    const double* __restrict__ Z = coef[2];
+    const long sy = st[1];
+    const double hx = inv_h[0], hy = inv_h[1];
+#pragma GCC ivdep
+    for (int i = 0; i < n; ++i)
+      out[i] = tensor_divergence_2d(u + i, X + i, Y + i, Z + i, sy, hx, hy);
+    return;
+  }
   const double* c[NC];
   for (int i = 0; i < n; ++i) {
     for (int q = 0; q < NC; ++q)

@@ -140,6 +140,24 @@ void DiffusionOperator::weights(PetscInt i, PetscInt j, PetscInt k, double* w) c
 
 namespace {
 
+// D times a constant stencil of NT terms along a row (NT fixed so the loop vectorises).
+template <int NT>
+void constant_row(const double* w_in, const long* delta_in, double D, const double* u, int n,
+                  double* out) {
+  double w[NT];
+  long delta[NT];
+  for (int t = 0; t < NT; ++t) {
+    w[t] = w_in[t];
+    delta[t] = delta_in[t];
+  }
+  for (int m = 0; m < n; ++m) {
+    double v = 0;
+    for (int t = 0; t < NT; ++t)
+      v += w[t] * u[m + delta[t]];
+    out[m] = D * v;
+  }
+}
+
 template <int Dim>
 void dispatch_row(DiffusionScheme s, int n, const double* const* coef, const long* st,
                   const double* u, const double* inv_h, double* out) {
@@ -159,12 +177,15 @@ void dispatch_row(DiffusionScheme s, int n, const double* const* coef, const lon
 
 void DiffusionOperator::apply_row(const double* u, PetscInt c, int n, double* out) const {
   if (scheme_ == DiffusionScheme::Constant) {
-    const int nt = stencil_.nterms;
-    for (int m = 0; m < n; ++m) {
-      double v = 0;
-      for (int t = 0; t < nt; ++t)
-        v += stencil_.w[t] * u[c + m + delta_[t]];
-      out[m] = D_ * v;
+    switch (stencil_.nterms) {
+    case 5:
+      constant_row<5>(stencil_.w.data(), delta_.data(), D_, u + c, n, out);
+      break;
+    case 7:
+      constant_row<7>(stencil_.w.data(), delta_.data(), D_, u + c, n, out);
+      break;
+    default:
+      constant_row<9>(stencil_.w.data(), delta_.data(), D_, u + c, n, out);
     }
     return;
   }
