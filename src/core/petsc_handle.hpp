@@ -4,6 +4,9 @@
 #pragma once
 
 #include <petscdm.h>
+#include <petscksp.h>
+#include <petscmat.h>
+#include <petscts.h>
 #include <petscsf.h>
 #include <petscvec.h>
 #include <string>
@@ -44,6 +47,9 @@ private:
 using VecH = PetscHandle<Vec, VecDestroy>;
 using DMH = PetscHandle<DM, DMDestroy>;
 using SFH = PetscHandle<PetscSF, PetscSFDestroy>;
+using MatH = PetscHandle<Mat, MatDestroy>;
+using KSPH = PetscHandle<KSP, KSPDestroy>;
+using TSH = PetscHandle<TS, TSDestroy>;
 
 // Throwing wrapper for PETSc calls made from code that cannot return PetscErrorCode
 // (constructors, destructors' callers). PETSc has already printed its trace when this fires.

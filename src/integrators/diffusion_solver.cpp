@@ -14,8 +14,8 @@ DiffusionSolver::DiffusionSolver(const Grid& grid, const OperatorMatrices& ops,
                                  const std::vector<std::string>& species, Options& opt)
     : grid_(grid), ops_(ops), species_(species) {
   const size_t ns = species.size();
-  A_.assign(ns, nullptr);
-  ksp_.assign(ns, nullptr);
+  A_.resize(ns);
+  ksp_.resize(ns);
   assembled_dt_.assign(ns, -1.0);
   assembled_theta_.assign(ns, -1.0);
   iterations_.assign(ns, 0);
@@ -32,13 +32,6 @@ DiffusionSolver::DiffusionSolver(const Grid& grid, const OperatorMatrices& ops,
     opt.known(name);
   for (size_t s = 0; s < ns; ++s)
     configure(static_cast<int>(s));
-}
-
-DiffusionSolver::~DiffusionSolver() {
-  for (auto& k : ksp_)
-    if (k) (void)KSPDestroy(&k);
-  for (auto& a : A_)
-    if (a) (void)MatDestroy(&a);
 }
 
 namespace {
@@ -61,8 +54,8 @@ void check_type_name(const char* option, PetscFunctionList list, const char* wha
 void DiffusionSolver::configure(int s) {
   int size = 1;
   MPI_Comm_size(grid_.comm(), &size);
-  KSP& ksp = ksp_[s];
-  MG_PETSC(KSPCreate(grid_.comm(), &ksp));
+  MG_PETSC(KSPCreate(grid_.comm(), ksp_[s].out()));
+  KSP ksp = ksp_[s];
   MG_PETSC(KSPSetOptionsPrefix(ksp, "diffusion_"));
   if (ops_.symmetric(s)) {
     set_cg_icc(ksp);
@@ -90,8 +83,7 @@ void DiffusionSolver::configure(int s) {
 
 void DiffusionSolver::prepare_species(int s, double dt, double theta) {
   if (ops_.scale(s) == 0.0 || (assembled_dt_[s] == dt && assembled_theta_[s] == theta)) return;
-  if (A_[s]) MG_PETSC(MatDestroy(&A_[s]));
-  MG_PETSC(MatDuplicate(ops_.M(s), MAT_COPY_VALUES, &A_[s]));
+  MG_PETSC(MatDuplicate(ops_.M(s), MAT_COPY_VALUES, A_[s].out()));
   MG_PETSC(MatScale(A_[s], -theta * dt * ops_.scale(s)));
   MG_PETSC(MatShift(A_[s], 1.0));
   MG_PETSC(KSPSetOperators(ksp_[s], A_[s], A_[s]));

@@ -35,7 +35,6 @@ public:
   // ops: the species' diffusion operators as matrices (kept by reference).
   DiffusionSolver(const Grid& grid, const OperatorMatrices& ops,
                   const std::vector<std::string>& species, Options& opt);
-  ~DiffusionSolver();
   DiffusionSolver(const DiffusionSolver&) = delete;
   DiffusionSolver& operator=(const DiffusionSolver&) = delete;
 
@@ -56,8 +55,8 @@ private:
   const Grid& grid_;
   const OperatorMatrices& ops_;
   std::vector<std::string> species_;
-  std::vector<Mat> A_;
-  std::vector<KSP> ksp_;
+  std::vector<KSPH> ksp_; // (PETSc reference-counts the operators they hold)
+  std::vector<MatH> A_;
   std::vector<double> assembled_dt_, assembled_theta_;
   std::vector<PetscInt> iterations_;
   PetscInt total_its_ = 0;

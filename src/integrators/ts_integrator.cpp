@@ -44,17 +44,11 @@ TsIntegrator::TsIntegrator(const Grid& grid, RatesFn rates, const std::vector<st
     build_operator();
     setup_ts(dt);
   } catch (...) {
-    if (ts_) (void)TSDestroy(&ts_);
-    if (J_) (void)MatDestroy(&J_);
-    if (Dblock_) (void)MatDestroy(&Dblock_);
+    ts_.reset();
+    J_.reset();
+    Dblock_.reset();
     throw;
   }
-}
-
-TsIntegrator::~TsIntegrator() {
-  if (ts_) (void)TSDestroy(&ts_);
-  if (J_) (void)MatDestroy(&J_);
-  if (Dblock_) (void)MatDestroy(&Dblock_);
 }
 
 // blockdiag(D_s L) in the block layout, the block Dirichlet vector and the block state.
@@ -96,7 +90,7 @@ void TsIntegrator::build_operator() {
       onz[static_cast<size_t>(s * nloc_ + g - rstart)] = o;
     }
   }
-  MG_PETSC(MatCreate(comm, &Dblock_));
+  MG_PETSC(MatCreate(comm, Dblock_.out()));
   MG_PETSC(MatSetSizes(Dblock_, nb, nb, PETSC_DETERMINE, PETSC_DETERMINE));
   MG_PETSC(MatSetType(Dblock_, MATAIJ));
   MG_PETSC(MatSeqAIJSetPreallocation(Dblock_, 0, dnz.data()));
@@ -125,7 +119,7 @@ void TsIntegrator::build_operator() {
   }
   MG_PETSC(MatAssemblyBegin(Dblock_, MAT_FINAL_ASSEMBLY));
   MG_PETSC(MatAssemblyEnd(Dblock_, MAT_FINAL_ASSEMBLY));
-  MG_PETSC(MatDuplicate(Dblock_, MAT_COPY_VALUES, &J_));
+  MG_PETSC(MatDuplicate(Dblock_, MAT_COPY_VALUES, J_.out()));
 
   // Block state X and block Dirichlet vector D_s b_s.
   MG_PETSC(VecCreate(comm, X_.out()));
@@ -156,7 +150,7 @@ void TsIntegrator::setup_ts(double dt) {
   MPI_Comm comm = grid_.comm();
   int size = 1;
   MPI_Comm_size(comm, &size);
-  MG_PETSC(TSCreate(comm, &ts_));
+  MG_PETSC(TSCreate(comm, ts_.out()));
   MG_PETSC(TSSetType(ts_, TSARKIMEX));
   MG_PETSC(TSARKIMEXSetType(ts_, TSARKIMEX2E));
   MG_PETSC(TSSetProblemType(ts_, TS_NONLINEAR));

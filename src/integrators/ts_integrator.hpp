@@ -61,7 +61,6 @@ public:
   TsIntegrator(const Grid& grid, RatesFn rates, const std::vector<std::string>& species,
                const ParamSet& params, std::vector<double> floor, const OperatorMatrices& ops,
                SourceTerms* sources, double dt);
-  ~TsIntegrator();
   TsIntegrator(const TsIntegrator&) = delete;
   TsIntegrator& operator=(const TsIntegrator&) = delete;
 
@@ -72,7 +71,7 @@ public:
   PetscInt total_steps() const { return steps_; }       // accepted internal TS steps so far
   PetscInt total_rejected() const { return rejected_; } // rejected internal TS steps so far
   bool adaptive() const { return adaptive_; }
-  TS ts() const { return ts_; }
+  TS ts() const { return ts_.get(); }
 
 private:
   static PetscErrorCode ifunction_cb(TS, PetscReal t, Vec X, Vec Xdot, Vec F, void* ctx);
@@ -101,10 +100,10 @@ private:
 
   VecH X_, bD_;              // block state; block D_s b_s (Dirichlet data)
   bool has_b_ = false;       // any Dirichlet data at all
-  Mat Dblock_ = nullptr;     // blockdiag(scale_s M_s)
-  Mat J_ = nullptr;          // shift I - Dblock
+  MatH Dblock_;              // blockdiag(scale_s M_s)
+  MatH J_;                   // shift I - Dblock
   PetscReal jac_shift_ = -1; // shift J_ holds (-1: stale)
-  TS ts_ = nullptr;
+  TSH ts_; // destroyed before the matrices it uses
   bool adaptive_ = false;
   double next_dt_ = 0; // the adaptive controller's proposal for the next internal step
   bool solved_ = false;

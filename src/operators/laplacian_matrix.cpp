@@ -38,7 +38,7 @@ void LaplacianMatrix::assemble(const Grid& grid, const Halo& halo, const CellTer
   const GridSpec& g = grid.spec();
   DM dm = grid.dm();
   MG_PETSC(DMSetMatType(dm, MATAIJ));
-  MG_PETSC(DMCreateMatrix(dm, &L_));
+  MG_PETSC(DMCreateMatrix(dm, L_.out()));
   // Preallocated for the DMDA's stencil (box when any operator has cross terms): a term
   // outside it is a bug, reported instead of silently reallocating.
   MG_PETSC(MatSetOption(L_, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));

@@ -33,20 +33,17 @@ public:
   // value sets in `dirichlet` (may be null).
   LaplacianMatrix(const Grid& grid, const Halo& halo, const CellTermsFn& terms, int nspecies,
                   const std::vector<FaceValues>* dirichlet);
-  ~LaplacianMatrix() {
-    if (L_) (void)MatDestroy(&L_);
-  }
   LaplacianMatrix(const LaplacianMatrix&) = delete;
   LaplacianMatrix& operator=(const LaplacianMatrix&) = delete;
 
-  Mat L() const { return L_; }
+  Mat L() const { return L_.get(); }
   Vec b(int species) const { return b_[species]; }
 
 private:
   void assemble(const Grid& grid, const Halo& halo, const CellTermsFn& terms, int nspecies,
                 const std::vector<FaceValues>* dirichlet);
 
-  Mat L_ = nullptr;
+  MatH L_;
   std::vector<VecH> b_;
 };
 
