@@ -30,6 +30,7 @@
 #include "models/model.hpp" // MG_HD
 
 #include <cmath>
+#include <utility>
 
 namespace morphogen {
 
@@ -208,36 +209,52 @@ MG_HD inline double tensor_divergence_2d(const double* u, const double* X, const
   return 0.5 * ((fxp - fxm) * hx + (fyp - fym) * hy);
 }
 
+// Flux of dual cell M (bit per transverse axis: 1 = the +side) through the face of the centre
+// cell on side Side of axis A, times h_A-scaled differences (all loops fixed at compile time).
+template <int Dim, int A, int Side, int M>
+MG_HD inline double dual_face_flux(const double* u, const double* const* cq, const long* st,
+                                   const double* inv_h, long o) {
+  using T = TensorLayout<Dim>;
+  constexpr auto up = [](int b) { return ((M >> (b < A ? b : b - 1)) & 1) != 0; };
+  const long oN = Side ? st[A] : -st[A];
+  long ql = o + (Side ? 0 : -st[A]); // the dual cell's lower cell (o: the centre's offset in cq)
+  for (int b = 0; b < Dim; ++b)
+    if (b != A && !up(b)) ql -= st[b];
+  double f = cq[T::index(A, A)][ql] * (Side ? u[oN] - u[0] : u[0] - u[oN]) * inv_h[A];
+  for (int b = 0; b < Dim; ++b) {
+    if (b == A) continue;
+    const double dP = up(b) ? u[st[b]] - u[0] : u[0] - u[-st[b]];
+    const double dN = up(b) ? u[oN + st[b]] - u[oN] : u[oN] - u[oN - st[b]];
+    f += cq[T::index(A, b)][ql] * 0.5 * (dP + dN) * inv_h[b];
+  }
+  return f;
+}
+
+template <int Dim, int A, int Side, int... M>
+MG_HD inline double face_flux(const double* u, const double* const* cq, const long* st,
+                              const double* inv_h, long o, std::integer_sequence<int, M...>) {
+  return (dual_face_flux<Dim, A, Side, M>(u, cq, st, inv_h, o) + ...) * (1.0 / sizeof...(M));
+}
+
+template <int Dim, int... A>
+MG_HD inline double tensor_divergence_axes(const double* u, const double* const* cq,
+                                           const long* st, const double* inv_h, long o,
+                                           std::integer_sequence<int, A...>) {
+  constexpr auto faces = std::make_integer_sequence<int, 1 << (Dim - 1)>{};
+  return (((face_flux<Dim, A, 1>(u, cq, st, inv_h, o, faces) -
+            face_flux<Dim, A, 0>(u, cq, st, inv_h, o, faces)) *
+           inv_h[A]) +
+          ...);
+}
+
 template <int Dim>
 MG_HD inline double tensor_divergence(const double* u, const double* const* cq, const long* st,
                                       const double* inv_h) {
-  if constexpr (Dim == 2) return tensor_divergence_2d(u, cq[0], cq[1], cq[2], st[1], inv_h[0], inv_h[1]);
-  using T = TensorLayout<Dim>;
-  constexpr int NF = 1 << (Dim - 1); // dual cells per face
-  double div = 0.0;
-  for (int a = 0; a < Dim; ++a)
-    for (int side = 0; side < 2; ++side) {
-      const long oN = side ? st[a] : -st[a];
-      const double dA = side ? u[oN] - u[0] : u[0] - u[oN];
-      double F = 0.0;
-      for (int m = 0; m < NF; ++m) {
-        // The dual cell's lower cell, relative to P.
-        long ql = side ? 0 : -st[a];
-        for (int b = 0, bit = 0; b < Dim; ++b)
-          if (b != a && !((m >> bit++) & 1)) ql -= st[b];
-        double f = cq[T::index(a, a)][ql] * dA * inv_h[a];
-        for (int b = 0, bit = 0; b < Dim; ++b) {
-          if (b == a) continue;
-          const bool up = (m >> bit++) & 1;
-          const double dP = up ? u[st[b]] - u[0] : u[0] - u[-st[b]];
-          const double dN = up ? u[oN + st[b]] - u[oN] : u[oN] - u[oN - st[b]];
-          f += cq[T::index(a, b)][ql] * 0.5 * (dP + dN) * inv_h[b];
-        }
-        F += f;
-      }
-      div += (side ? F : -F) * (inv_h[a] / NF);
-    }
-  return div;
+  if constexpr (Dim == 2)
+    return tensor_divergence_2d(u, cq[0], cq[1], cq[2], st[1], inv_h[0], inv_h[1]);
+  else
+    return tensor_divergence_axes<Dim>(u, cq, st, inv_h, 0,
+                                       std::make_integer_sequence<int, Dim>{});
 }
 
 // First order (Witkin-Kass mask of the cell's own tensor c[q] at the cell).
@@ -282,6 +299,19 @@ inline void diffusion_row(int n, const double* const* coef, const long* st, cons
 #pragma GCC ivdep
     for (int i = 0; i < n; ++i)
       out[i] = tensor_divergence_2d(u + i, X + i, Y + i, Z + i, sy, hx, hy);
+    return;
+  }
+  if constexpr (S == DiffusionScheme::Tensor) {
+    // Fixed component pointers and a running offset (so the loop vectorises).
+    const double* c[NC];
+    for (int q = 0; q < NC; ++q)
+      c[q] = coef[q];
+    const long s3[3] = {st[0], st[1], st[2]};
+    const double ih[3] = {inv_h[0], inv_h[1], inv_h[2]};
+#pragma GCC ivdep
+    for (int i = 0; i < n; ++i)
+      out[i] = tensor_divergence_axes<Dim>(u + i, c, s3, ih, i,
+                                           std::make_integer_sequence<int, Dim>{});
     return;
   }
   const double* c[NC];
