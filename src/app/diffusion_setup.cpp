@@ -23,7 +23,9 @@ struct TensorKeys {
   bool components = false;
 };
 
-// The option names of species `name`'s tensor: the per-species ones if any is set.
+// The option names of species `name`'s tensor, per key with a fallback: -tensor_S_NAME if
+// set, else the shared -tensor_NAME (its default when unset). Components (xx, xy, ...) and
+// principal values (theta, l1, ...) cannot be mixed for one species.
 TensorKeys tensor_keys(const Options& opt, int dim, const std::string& name) {
   const std::vector<std::string> principal =
       dim == 2 ? std::vector<std::string>{"theta", "l1", "l2"}
@@ -31,15 +33,24 @@ TensorKeys tensor_keys(const Options& opt, int dim, const std::string& name) {
   const std::vector<std::string> comps =
       dim == 2 ? std::vector<std::string>{"xx", "xy", "yy"}
                : std::vector<std::string>{"xx", "xy", "xz", "yy", "yz", "zz"};
-  std::string prefix = "tensor_";
-  for (const auto* set : {&principal, &comps})
-    for (const auto& k : *set)
-      if (opt.is_set("tensor_" + name + "_" + k)) prefix = "tensor_" + name + "_";
+  auto key = [&](const std::string& k) {
+    const std::string own = "tensor_" + name + "_" + k;
+    return opt.is_set(own) ? own : "tensor_" + k;
+  };
+  auto first_set = [&](const std::vector<std::string>& ks) {
+    for (const auto& k : ks)
+      if (opt.is_set(key(k))) return key(k);
+    return std::string();
+  };
+  const std::string c = first_set(comps), p = first_set(principal);
+  if (!c.empty() && !p.empty())
+    throw UserError("-" + c + " and -" + p + ": the tensor of " + name +
+                    " is given either by components (xx, xy, ...) or by principal values and "
+                    "angles (theta, l1, ...), not both");
   TensorKeys tk;
-  for (const auto& k : comps)
-    tk.components |= opt.is_set(prefix + k);
+  tk.components = !c.empty();
   for (const auto& k : tk.components ? comps : principal) {
-    tk.keys.push_back(prefix + k);
+    tk.keys.push_back(key(k));
     tk.defs.push_back(k == "theta" || k == "xy" || k == "xz" || k == "yz" ? "0"
                       : k == "phi"                                         ? "pi/2"
                                                                            : "1");

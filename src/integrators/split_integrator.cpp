@@ -22,6 +22,7 @@ SplitIntegrator::SplitIntegrator(const Grid& grid, ReactionRowFn fn,
     for (size_t q = 0; q < params_.scalar.size(); ++q)
       const_rows_.emplace_back(params_.field[q].get() ? 0 : row, params_.scalar[q]);
   row_out_.assign(species.size(), std::vector<double>(row));
+  substeps_ = split_substeps(set_.ordering);
   global_ = grid.create_global();
 }
 
@@ -118,14 +119,21 @@ void SplitIntegrator::diffuse(std::vector<VecH>& u, double dt, PetscInt step) {
   }
 }
 
+std::vector<Substep> split_substeps(SplitOrdering ordering) {
+  using K = Substep::Kind;
+  if (ordering == SplitOrdering::Lie) return {{K::Reaction, 1.0}, {K::Diffusion, 1.0}};
+  return {{K::Reaction, 0.5}, {K::Diffusion, 1.0}, {K::Reaction, 0.5}};
+}
+
 void SplitIntegrator::step(std::vector<VecH>& u, double t, double dt, PetscInt step) {
-  if (set_.ordering == SplitOrdering::Lie) {
-    react(u, t, dt, step);
-    diffuse(u, dt, step);
-  } else {
-    react(u, t, 0.5 * dt, step);
-    diffuse(u, dt, step);
-    react(u, t + 0.5 * dt, 0.5 * dt, step);
+  double t_reaction = t; // the reaction's (and sources') clock advances with its substeps
+  for (const Substep& sub : substeps_) {
+    if (sub.kind == Substep::Kind::Reaction) {
+      react(u, t_reaction, sub.fraction * dt, step);
+      t_reaction += sub.fraction * dt;
+    } else {
+      diffuse(u, sub.fraction * dt, step);
+    }
   }
   apply_floor(grid_, u, floor_);
 }

@@ -1,4 +1,5 @@
-// Operator-splitting integrator (unconditionally stable for the diffusion part):
+// Operator-splitting integrator (unconditionally stable for the diffusion part), a list of
+// substeps (split_substeps):
 //
 //   Lie (first order):     u <- D(dt) R(dt) u
 //   Strang (second order): u <- R(dt/2) D(dt) R(dt/2) u
@@ -27,6 +28,14 @@ using ReactionRowFn = int (*)(ReactionScheme, int, const double* const*, const d
                               double, int, const double*, double* const*, CellSolve*);
 
 enum class SplitOrdering { Lie, Strang };
+
+// One substep of a split step: the reaction (with sources) or the diffusion over a fraction of
+// dt. Lie is {R 1, D 1}; Strang is {R 1/2, D 1, R 1/2}.
+struct Substep {
+  enum class Kind { Reaction, Diffusion } kind;
+  double fraction;
+};
+std::vector<Substep> split_substeps(SplitOrdering ordering);
 
 struct SplitSettings {
   SplitOrdering ordering = SplitOrdering::Strang;
@@ -60,6 +69,7 @@ private:
   SourceTerms* sources_;
   DiffusionSolver& diffusion_;
   SplitSettings set_;
+  std::vector<Substep> substeps_;
   std::vector<std::vector<double>> const_rows_, row_out_;
   VecH global_;
   int last_its_ = 0;

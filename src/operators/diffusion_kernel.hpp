@@ -48,29 +48,21 @@ template <int Dim> struct TensorLayout {
   }
 };
 
-// Second-order conservative weights w[nb] of div(sigma grad u) at the centre cell.
+// Second-order conservative weights w[nb] of div(sigma grad u) at the centre cell from the
+// tensors of its 2^dim dual cells: sq[q * nc + m], dual cell q with lower cell (bit - 1) per
+// axis (bit d of q).
 template <int Dim>
-MG_HD inline void tensor_weights(const double* c, const double* inv_h, double* w) {
+MG_HD inline void tensor_weights_dual(const double* sq, const double* inv_h, double* w) {
   using T = TensorLayout<Dim>;
-  constexpr int NQ = 1 << Dim; // cells per dual cell, corners per dual cell
+  constexpr int NQ = 1 << Dim; // dual cells around the centre, corners per dual cell
   for (int t = 0; t < T::nb; ++t)
     w[t] = 0.0;
   for (int q = 0; q < NQ; ++q) {
-    // Dual cell with lower cell l = (bit - 1) per axis; the centre cell is its corner bp = -l.
     int l[3] = {0, 0, 0};
     for (int d = 0; d < Dim; ++d)
       l[d] = ((q >> d) & 1) - 1;
-    const int bp = (~q) & (NQ - 1);
-    double s[T::nc];
-    for (int m = 0; m < T::nc; ++m)
-      s[m] = 0.0;
-    for (int b = 0; b < NQ; ++b) {
-      const int t = T::box(l[0] + (b & 1), l[1] + ((b >> 1) & 1), Dim == 3 ? l[2] + (b >> 2) : 0);
-      for (int m = 0; m < T::nc; ++m)
-        s[m] += c[t * T::nc + m];
-    }
-    for (int m = 0; m < T::nc; ++m)
-      s[m] *= 1.0 / NQ;
+    const int bp = (~q) & (NQ - 1); // the centre's corner in this dual cell
+    const double* s = sq + q * T::nc;
     for (int b = 0; b < NQ; ++b) {
       const int diff = b ^ bp;
       for (int a = 0; a < Dim; ++a) {
@@ -87,6 +79,27 @@ MG_HD inline void tensor_weights(const double* c, const double* inv_h, double* w
       }
     }
   }
+}
+
+// The same from the cells' tensors: each dual cell's tensor is the mean of its 2^dim cells.
+template <int Dim>
+MG_HD inline void tensor_weights(const double* c, const double* inv_h, double* w) {
+  using T = TensorLayout<Dim>;
+  constexpr int NQ = 1 << Dim;
+  double sq[NQ * T::nc];
+  for (int q = 0; q < NQ; ++q) {
+    int l[3] = {0, 0, 0};
+    for (int d = 0; d < Dim; ++d)
+      l[d] = ((q >> d) & 1) - 1;
+    for (int m = 0; m < T::nc; ++m)
+      sq[q * T::nc + m] = 0.0;
+    for (int b = 0; b < NQ; ++b) {
+      const int t = T::box(l[0] + (b & 1), l[1] + ((b >> 1) & 1), Dim == 3 ? l[2] + (b >> 2) : 0);
+      for (int m = 0; m < T::nc; ++m)
+        sq[q * T::nc + m] += c[t * T::nc + m] * (1.0 / NQ);
+    }
+  }
+  tensor_weights_dual<Dim>(sq, inv_h, w);
 }
 
 // First-order (Witkin-Kass) mask of the centre cell's tensor.

@@ -108,7 +108,54 @@ void DiffusionOperator::build_dual_tensors() {
                             (dim == 3 ? (b >> 2) * st_[2] : 0)];
           dual_[q][l] = sum / nq;
         }
+        zero_flux_dual(i, j, k, l);
       }
+}
+
+void DiffusionOperator::zero_flux_dual(PetscInt i, PetscInt j, PetscInt k, PetscInt l) {
+  // A dual cell that straddles a zero-flux face: the mean over its interior cells, then for
+  // each straddled normal n the tangential block under n.sigma grad u = 0 (the Schur
+  // complement sigma_tt - sigma_tn sigma_nt / sigma_nn) and sigma_tn = 0, so the tangential
+  // flux next to the wall keeps its normal-gradient part (second order at the wall).
+  const GridSpec& g = grid_.spec();
+  const int dim = grid_.dim(), nq = 1 << dim, nc = static_cast<int>(coef_.size());
+  const PetscInt lc[3] = {i, j, k};
+  int straddle = 0;
+  for (int d = 0; d < dim; ++d)
+    if (g.bc[d] == Boundary::Neumann && (lc[d] == -1 || lc[d] == g.n[d] - 1)) straddle |= 1 << d;
+  if (!straddle) return;
+  double s[6] = {0, 0, 0, 0, 0, 0};
+  int count = 0;
+  for (int b = 0; b < nq; ++b) {
+    bool inside = true;
+    for (int d = 0; d < dim; ++d) {
+      const PetscInt c = lc[d] + ((b >> d) & 1);
+      if ((straddle >> d) & 1) inside = inside && c >= 0 && c < g.n[d];
+    }
+    if (!inside) continue;
+    ++count;
+    for (int q = 0; q < nc; ++q)
+      s[q] += coef_[q][l + (b & 1) * st_[0] + ((b >> 1) & 1) * st_[1] +
+                       (dim == 3 ? (b >> 2) * st_[2] : 0)];
+  }
+  for (int q = 0; q < nc; ++q)
+    s[q] /= count;
+  auto idx = [dim](int a, int b) {
+    return dim == 2 ? TensorLayout<2>::index(a, b) : TensorLayout<3>::index(a, b);
+  };
+  for (int n = 0; n < dim; ++n) {
+    if (!((straddle >> n) & 1)) continue;
+    double t[6];
+    std::copy(s, s + nc, t);
+    for (int a = 0; a < dim; ++a)
+      for (int b = a; b < dim; ++b)
+        if (a != n && b != n) t[idx(a, b)] = s[idx(a, b)] - s[idx(a, n)] * s[idx(b, n)] / s[idx(n, n)];
+    for (int a = 0; a < dim; ++a)
+      if (a != n) t[idx(a, n)] = 0.0;
+    std::copy(t, t + nc, s);
+  }
+  for (int q = 0; q < nc; ++q)
+    dual_[q][l] = s[q];
 }
 
 bool DiffusionOperator::box() const {
@@ -128,6 +175,21 @@ void DiffusionOperator::weights(PetscInt i, PetscInt j, PetscInt k, double* w) c
   }
   const PetscInt c = grid_.local_index(i, j, k);
   const int nc = static_cast<int>(coef_.size());
+  if (scheme_ == DiffusionScheme::Tensor) { // from the dual-cell tensors, as the explicit sweep
+    double sq[8 * 6];
+    for (int q = 0; q < (1 << dim); ++q) {
+      long off = 0;
+      for (int d = 0; d < dim; ++d)
+        off += (((q >> d) & 1) - 1) * st_[d];
+      for (int m = 0; m < nc; ++m)
+        sq[q * nc + m] = dual_[m][c + off];
+    }
+    if (dim == 2)
+      tensor_weights_dual<2>(sq, inv_h_, w);
+    else
+      tensor_weights_dual<3>(sq, inv_h_, w);
+    return;
+  }
   double cv[27 * 6];
   for (int t = 0; t < nb; ++t)
     for (int q = 0; q < nc; ++q)

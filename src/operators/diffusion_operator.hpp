@@ -8,7 +8,10 @@
 // Coefficient fields are copied into ghosted arrays once (they do not change during a run);
 // their ghosts come from the halo exchange and, outside non-periodic faces, from the mirror
 // cell (a tensor's off-diagonal component with the sign of the reflection), so that no flux
-// crosses a zero-flux face. The weights of an owned cell are the same numbers for the explicit
+// crosses a zero-flux face; dual cells straddling a zero-flux face use the tangential tensor
+// under n.sigma grad u = 0 (second order at the wall). At a Dirichlet face the boundary flux
+// omits sigma_nt dg/dt (first order there when g varies along a face with sigma_nt != 0; the
+// matrix stays symmetric). The weights of an owned cell are the same numbers for the explicit
 // sweep (apply_row) and for the matrix assembly (weights), so L u + b is the explicit operator.
 #pragma once
 
@@ -56,6 +59,7 @@ public:
 private:
   void finish_setup(const Halo& halo);
   void build_dual_tensors();
+  void zero_flux_dual(PetscInt i, PetscInt j, PetscInt k, PetscInt l);
 
   const Grid& grid_;
   DiffusionScheme scheme_;
