@@ -47,8 +47,8 @@
 // e^T S_b e / e^T S_a e).
 #pragma once
 
-#include "models/model_info.hpp"
 #include "grid/grid.hpp"
+#include "models/model_info.hpp"
 
 #include <array>
 #include <complex>

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <sstream>
 
@@ -52,8 +53,8 @@ TensorKeys tensor_keys(const Options& opt, int dim, const std::string& name) {
   for (const auto& k : tk.components ? comps : principal) {
     tk.keys.push_back(key(k));
     tk.defs.push_back(k == "theta" || k == "xy" || k == "xz" || k == "yz" ? "0"
-                      : k == "phi"                                         ? "pi/2"
-                                                                           : "1");
+                      : k == "phi"                                        ? "pi/2"
+                                                                          : "1");
   }
   return tk;
 }
@@ -135,11 +136,19 @@ DiffusionSetup read_diffusion(Options& opt, const Grid& grid, const Halo& halo,
   const int dim = grid.dim();
   const std::string name = si.name;
   const std::string dkey = "D_" + name;
-  ValueSpec D(dkey,
-              opt.string(dkey, format_double(si.D),
-                         "diffusion coefficient of " + name + " (" + si.doc +
-                             "): a number, or a field (expression, 'v +- a%', png(...))"),
-              spec, seed, base_dir);
+  const std::string dtext =
+      opt.string(dkey, format_double(si.D),
+                 "diffusion coefficient of " + name + " (" + si.doc +
+                     "): a number, or a field (expression, 'v +- a%', png(...))");
+  {
+    // A plain number (inf included) is range-checked as a number.
+    char* end = nullptr;
+    const double v = std::strtod(dtext.c_str(), &end);
+    if (end && end != dtext.c_str() && *end == '\0' && !(v >= 0 && v <= kMaxReal))
+      throw UserError("-" + dkey + " " + dtext + ": out of range, allowed [0, " +
+                      format_double(kMaxReal) + "]");
+  }
+  ValueSpec D(dkey, dtext, spec, seed, base_dir);
   if (D.uses_time())
     throw UserError("-" + dkey + " " + D.text() + ": time-dependent diffusion is not supported");
   DiffusionSetup out;
@@ -176,8 +185,8 @@ DiffusionSetup read_diffusion(Options& opt, const Grid& grid, const Halo& halo,
         : tk.keys[q].find("phi") != std::string::npos
             ? "polar angle of the first principal direction from the z axis (radians)"
             : "principal diffusivity (times D_S, > 0); a value";
-    vals.push_back(std::make_unique<ValueSpec>(
-        tk.keys[q], opt.string(tk.keys[q], tk.defs[q], help), spec, seed, base_dir));
+    vals.push_back(std::make_unique<ValueSpec>(tk.keys[q], opt.string(tk.keys[q], tk.defs[q], help),
+                                               spec, seed, base_dir));
     if (vals.back()->uses_time())
       throw UserError("-" + tk.keys[q] + " " + vals.back()->text() +
                       ": time-dependent tensors are not supported");
@@ -200,7 +209,8 @@ DiffusionSetup read_diffusion(Options& opt, const Grid& grid, const Halo& halo,
           if (surface) // the tensor is meant on the surface: correct it for the map's metric
             surface->corrected_tensor(grid.centre(0, i), grid.centre(1, j), s, s);
           const double d = D.at_cell(i, j, k);
-          const bool pd = dim == 2 ? tensor_positive_definite<2>(s) : tensor_positive_definite<3>(s);
+          const bool pd =
+              dim == 2 ? tensor_positive_definite<2>(s) : tensor_positive_definite<3>(s);
           bool finite = std::isfinite(d);
           for (int q = 0; q < nc; ++q)
             finite = finite && std::isfinite(s[q]);

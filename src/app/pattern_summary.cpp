@@ -46,6 +46,7 @@ nlohmann::json metrics_json(const analysis::PatternMetrics& m) {
           {"wavelength_cells", num(m.wavelength_cells)},
           {"peak_sharpness", num(m.peak_sharpness)},
           {"spectral_anisotropy", num(m.spectral_anisotropy)},
+          {"spectral_angle_deg", num(m.spectral_angle * 180.0 / M_PI)},
           {"coherence", num(m.coherence)},
           {"threshold", num(m.threshold)},
           {"euler", m.euler},

@@ -133,9 +133,22 @@ void Simulation::read_diffusion_kinds(Options& opt, const std::string& stencil) 
     spec_.box_stencil = true; // cross terms read the ghost corners
     if (stencil == "9pt")
       throw UserError("-stencil 9pt: the isotropic 9-point stencil cannot be combined with "
-                      "-diffusion_" + std::string(model_->species[s].name) +
+                      "-diffusion_" +
+                      std::string(model_->species[s].name) +
                       " tensor (the tensor operator has its own box stencil); use -stencil 5pt");
   }
+  check_surface_needs_tensor(opt);
+}
+
+void Simulation::check_surface_needs_tensor(const Options& opt) const {
+  bool any_tensor = false;
+  for (bool t : tensor_)
+    any_tensor = any_tensor || t;
+  for (const char* k : {"surface_x", "surface_y", "surface_z"})
+    if (opt.is_set(k) && !any_tensor)
+      throw UserError(std::string("-") + k +
+                      ": the surface-metric correction applies to diffusion tensors; add "
+                      "-diffusion tensor (the default l1 = l2 = 1 is isotropic on the surface)");
 }
 
 void Simulation::read_model(Options& opt, const std::string& base_dir) {
@@ -269,7 +282,8 @@ void Simulation::read_model(Options& opt, const std::string& base_dir) {
   integrator_ = std::make_unique<ExplicitIntegrator>(
       *grid_, *halo_, fn, ns, stencil_, D_, floor_, params_, any_dirichlet ? &dirichlet_ : nullptr);
   if (!all_constant_diffusion())
-    integrator_->use_operators(operators(), model_->kernels.explicit_pre[params_.any_field() ? 1 : 0]);
+    integrator_->use_operators(operators(),
+                               model_->kernels.explicit_pre[params_.any_field() ? 1 : 0]);
   integrator_->update_ghosts(u_);
 }
 
@@ -298,14 +312,14 @@ void Simulation::read_time(Options& opt) {
     for (const auto& op : ops_)
       lmax = std::max(lmax, op->max_eigenvalue());
     if (dt_ > stable_dt_ && !force && !constant)
-      throw UserError("-dt " + format_double(dt_) +
-                      ": exceeds the explicit diffusion stability bound dt <= " +
-                      format_double(stable_dt_) +
-                      " (2/(lambda_max*rho(L)), the largest eigenvalue of the diffusion "
-                      "tensors/maps over the grid lambda_max = " +
-                      format_double(lmax) +
-                      "); use a smaller -dt, -integrator split (unconditionally stable "
-                      "diffusion), or -force_dt");
+      throw UserError(
+          "-dt " + format_double(dt_) +
+          ": exceeds the explicit diffusion stability bound dt <= " + format_double(stable_dt_) +
+          " (2/(lambda_max*rho(L)), the largest eigenvalue of the diffusion "
+          "tensors/maps over the grid lambda_max = " +
+          format_double(lmax) +
+          "); use a smaller -dt, -integrator split (unconditionally stable "
+          "diffusion), or -force_dt");
     if (dt_ > stable_dt_ && !force)
       throw UserError(
           "-dt " + format_double(dt_) + ": exceeds the explicit diffusion stability bound dt <= " +
@@ -362,8 +376,8 @@ void Simulation::read_time(Options& opt) {
     diffusion_ = std::make_unique<DiffusionSolver>(*grid_, *matrices_, species_, opt);
     diffusion_->prepare(dt_, set.theta);
     split_integrator_ = std::make_unique<SplitIntegrator>(
-        *grid_, model_->kernels.reaction_row[params_.any_field() ? 1 : 0], species_, params_, floor_,
-        sources_.get(), *diffusion_, set);
+        *grid_, model_->kernels.reaction_row[params_.any_field() ? 1 : 0], species_, params_,
+        floor_, sources_.get(), *diffusion_, set);
   }
 }
 

@@ -97,6 +97,7 @@ private:
   void read_grid(Options& opt, const SequenceLevel& level);
   void start_from(Simulation& coarser);
   void read_diffusion_kinds(Options& opt, const std::string& stencil);
+  void check_surface_needs_tensor(const Options& opt) const;
   void read_model(Options& opt, const std::string& base_dir);
   void read_time(Options& opt);
   void read_output(Options& opt);

@@ -10,8 +10,8 @@
 #include "core/user_error.hpp"
 
 #include <algorithm>
-#include <tuple>
 #include <cstdio>
+#include <tuple>
 #include <vector>
 
 using namespace morphogen;

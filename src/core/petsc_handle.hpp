@@ -6,8 +6,8 @@
 #include <petscdm.h>
 #include <petscksp.h>
 #include <petscmat.h>
-#include <petscts.h>
 #include <petscsf.h>
+#include <petscts.h>
 #include <petscvec.h>
 #include <string>
 #include <utility>

@@ -20,8 +20,8 @@
 
 #include "core/options.hpp"
 #include "grid/halo.hpp"
-#include "operators/operator_matrices.hpp"
 #include "grid/stencil.hpp"
+#include "operators/operator_matrices.hpp"
 
 #include <memory>
 #include <petscksp.h>

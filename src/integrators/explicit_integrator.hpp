@@ -16,9 +16,9 @@
 
 #include "fields/param_set.hpp"
 #include "grid/halo.hpp"
+#include "grid/stencil.hpp"
 #include "integrators/explicit_kernel.hpp"
 #include "operators/diffusion_operator.hpp"
-#include "grid/stencil.hpp"
 
 #include <vector>
 

@@ -27,7 +27,7 @@ struct ExplicitRow {
   const double* const* prow = nullptr; // [nparams] per-cell parameter rows (field mode)
   const double* pconst = nullptr;      // [nparams] parameter scalars (scalar mode)
   double dt = 0;
-  double* const* dst = nullptr; // [nspecies] output rows
+  double* const* dst = nullptr;       // [nspecies] output rows
   const double* const* div = nullptr; // [nspecies] precomputed diffusion rows (general path)
 };
 

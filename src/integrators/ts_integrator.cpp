@@ -28,10 +28,9 @@ struct QuietPetscErrors {
 
 TsIntegrator::TsIntegrator(const Grid& grid, RatesFn rates, const std::vector<std::string>& species,
                            const ParamSet& params, std::vector<double> floor,
-                           const OperatorMatrices& ops,
-                           SourceTerms* sources, double dt)
-    : grid_(grid), rates_(rates), species_(species), params_(params),
-      floor_(std::move(floor)), ops_(ops), sources_(sources) {
+                           const OperatorMatrices& ops, SourceTerms* sources, double dt)
+    : grid_(grid), rates_(rates), species_(species), params_(params), floor_(std::move(floor)),
+      ops_(ops), sources_(sources) {
   ns_ = static_cast<PetscInt>(species.size());
   nloc_ = grid.owned().size();
   if (ops_.nspecies() != static_cast<int>(species.size()) || floor_.size() != species.size() ||

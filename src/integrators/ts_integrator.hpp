@@ -9,8 +9,8 @@
 //
 // Layout: one MPI Vec X holds every species; this rank's block is species 0's owned cells
 // (owned layout, x fastest), then species 1's, ... (local size nspecies * owned cells). The
-// implicit operator is blockdiag(scale_s M_s) in that layout, assembled once by copying the rows with
-// column indices mapped to the block layout; the IJacobian shift*I - blockdiag(D_s L) is
+// implicit operator is blockdiag(scale_s M_s) in that layout, assembled once by copying the rows
+// with column indices mapped to the block layout; the IJacobian shift*I - blockdiag(D_s L) is
 // refreshed from it only when the shift changes (so a fixed dt factors the preconditioner once).
 //
 // Defaults (all overridable from the options database, no prefix: -ts_*, -snes_*, -ksp_*,
@@ -103,7 +103,7 @@ private:
   MatH Dblock_;              // blockdiag(scale_s M_s)
   MatH J_;                   // shift I - Dblock
   PetscReal jac_shift_ = -1; // shift J_ holds (-1: stale)
-  TSH ts_; // destroyed before the matrices it uses
+  TSH ts_;                   // destroyed before the matrices it uses
   bool adaptive_ = false;
   double next_dt_ = 0; // the adaptive controller's proposal for the next internal step
   bool solved_ = false;

@@ -29,9 +29,9 @@ struct ModelInfo {
 };
 
 template <class M> ModelInfo model_info() {
-  return {M::name,           M::doc,    M::reference,     M::nspecies,
-          M::nparams,        M::species.data(), M::params.data(), M::clamp_default,
-          &M::rates,         &M::jacobian, &M::steady_state};
+  return {M::name,           M::doc,           M::reference,     M::nspecies, M::nparams,
+          M::species.data(), M::params.data(), M::clamp_default, &M::rates,   &M::jacobian,
+          &M::steady_state};
 }
 
 namespace detail {
@@ -42,8 +42,8 @@ template <class Tuple, size_t... I> std::vector<ModelInfo> model_infos(std::inde
 
 // Every registered model, in AllModels order.
 inline const std::vector<ModelInfo>& model_infos() {
-  static const std::vector<ModelInfo> all = detail::model_infos<AllModels>(
-      std::make_index_sequence<std::tuple_size_v<AllModels>>{});
+  static const std::vector<ModelInfo> all =
+      detail::model_infos<AllModels>(std::make_index_sequence<std::tuple_size_v<AllModels>>{});
   return all;
 }
 

@@ -21,8 +21,11 @@
 //
 // tensor_weights_first_order (Witkin & Kass eqs. 6-7): the constant-coefficient mask of the
 // cell's own tensor, sum_ab sigma_ab(p) d_a d_b u with the 3-point second differences and the
-// 4-point centred mixed differences; no tensor-gradient terms (first order for a varying tensor,
-// not symmetric).
+// 4-point centred mixed differences. It approximates sigma : grad grad u (second order), which
+// misses div(sigma grad u) by (div sigma) . grad u: no tensor-gradient terms, so where sigma
+// varies it is not consistent with the divergence form (the difference of Sanderson's Fig. 7),
+// not conservative and not symmetric. With mirrored ghosts it imposes du/dn = 0 at zero-flux
+// walls (not n . sigma grad u = 0).
 //
 // isotropic_weights: div(D grad u) with the face coefficient the mean of the two cells' D.
 #pragma once
@@ -250,8 +253,8 @@ MG_HD inline double face_flux(const double* u, const double* const* cq, const lo
 }
 
 template <int Dim, int... A>
-MG_HD inline double tensor_divergence_axes(const double* u, const double* const* cq,
-                                           const long* st, const double* inv_h, long o,
+MG_HD inline double tensor_divergence_axes(const double* u, const double* const* cq, const long* st,
+                                           const double* inv_h, long o,
                                            std::integer_sequence<int, A...>) {
   constexpr auto faces = std::make_integer_sequence<int, 1 << (Dim - 1)>{};
   return (((face_flux<Dim, A, 1>(u, cq, st, inv_h, o, faces) -
@@ -266,8 +269,7 @@ MG_HD inline double tensor_divergence(const double* u, const double* const* cq, 
   if constexpr (Dim == 2)
     return tensor_divergence_2d(u, cq[0], cq[1], cq[2], st[1], inv_h[0], inv_h[1]);
   else
-    return tensor_divergence_axes<Dim>(u, cq, st, inv_h, 0,
-                                       std::make_integer_sequence<int, Dim>{});
+    return tensor_divergence_axes<Dim>(u, cq, st, inv_h, 0, std::make_integer_sequence<int, Dim>{});
 }
 
 // First order (Witkin-Kass mask of the cell's own tensor c[q] at the cell).
@@ -323,8 +325,8 @@ inline void diffusion_row(int n, const double* const* coef, const long* st, cons
     const double ih[3] = {inv_h[0], inv_h[1], inv_h[2]};
 #pragma GCC ivdep
     for (int i = 0; i < n; ++i)
-      out[i] = tensor_divergence_axes<Dim>(u + i, c, s3, ih, i,
-                                           std::make_integer_sequence<int, Dim>{});
+      out[i] =
+          tensor_divergence_axes<Dim>(u + i, c, s3, ih, i, std::make_integer_sequence<int, Dim>{});
     return;
   }
   const double* c[NC];

@@ -38,8 +38,8 @@ DiffusionOperator::DiffusionOperator(const Grid& grid, const Stencil& stencil, d
   iso_radius_ = iso_spectral_radius(grid);
   const PetscInt gx = grid.ghosted().m[0], gxy = gx * grid.ghosted().m[1];
   for (int t = 0; t < stencil.nterms; ++t)
-    delta_.push_back(static_cast<long>(stencil.off[t][0] + gx * stencil.off[t][1] +
-                                       gxy * stencil.off[t][2]));
+    delta_.push_back(
+        static_cast<long>(stencil.off[t][0] + gx * stencil.off[t][1] + gxy * stencil.off[t][2]));
 }
 
 DiffusionOperator::DiffusionOperator(const Grid& grid, const Halo& halo, DiffusionScheme scheme,
@@ -57,7 +57,8 @@ void DiffusionOperator::finish_setup(const Halo& halo) {
   const int nb = dim == 2 ? 9 : 27;
   delta_.assign(static_cast<size_t>(nb), 0);
   for (int t = 0; t < nb; ++t)
-    delta_[t] = static_cast<long>((t % 3 - 1) + gx * ((t / 3) % 3 - 1) + (dim == 3 ? gxy * (t / 9 - 1) : 0));
+    delta_[t] = static_cast<long>((t % 3 - 1) + gx * ((t / 3) % 3 - 1) +
+                                  (dim == 3 ? gxy * (t / 9 - 1) : 0));
   for (size_t q = 0; q < coef_.size(); ++q) {
     std::array<double, 3> sign{1, 1, 1};
     for (int d = 0; d < dim; ++d)
@@ -82,8 +83,8 @@ void DiffusionOperator::finish_setup(const Halo& halo) {
         for (size_t q = 0; q < coef_.size(); ++q)
           s[q] = coef_[q][c];
         const double l = scheme_ == DiffusionScheme::IsotropicField ? s[0]
-                         : dim == 2                                  ? local_max_eigenvalue<2>(s)
-                                                                     : local_max_eigenvalue<3>(s);
+                         : dim == 2                                 ? local_max_eigenvalue<2>(s)
+                                                                    : local_max_eigenvalue<3>(s);
         lmax = std::max(lmax, l);
       }
   MPI_Allreduce(&lmax, &lmax_, 1, MPI_DOUBLE, MPI_MAX, grid_.comm());
@@ -149,7 +150,8 @@ void DiffusionOperator::zero_flux_dual(PetscInt i, PetscInt j, PetscInt k, Petsc
     std::copy(s, s + nc, t);
     for (int a = 0; a < dim; ++a)
       for (int b = a; b < dim; ++b)
-        if (a != n && b != n) t[idx(a, b)] = s[idx(a, b)] - s[idx(a, n)] * s[idx(b, n)] / s[idx(n, n)];
+        if (a != n && b != n)
+          t[idx(a, b)] = s[idx(a, b)] - s[idx(a, n)] * s[idx(b, n)] / s[idx(n, n)];
     for (int a = 0; a < dim; ++a)
       if (a != n) t[idx(a, n)] = 0.0;
     std::copy(t, t + nc, s);

@@ -4,20 +4,23 @@
 //   IsotropicField  K = D(x) I, face coefficients the mean of the two cells.
 //   Tensor          K = a symmetric positive definite tensor field, the second-order
 //                   conservative discretisation of operators/diffusion_kernel.hpp.
-//   TensorFirstOrder  the same tensor with Witkin and Kass's first-order constant masks.
+//   TensorFirstOrder  the same tensor with Witkin and Kass's constant masks (sigma : grad grad u,
+//                   no tensor-gradient terms; du/dn = 0 at zero-flux walls; not conservative
+//                   where sigma varies).
 // Coefficient fields are copied into ghosted arrays once (they do not change during a run);
 // their ghosts come from the halo exchange and, outside non-periodic faces, from the mirror
 // cell (a tensor's off-diagonal component with the sign of the reflection), so that no flux
-// crosses a zero-flux face; dual cells straddling a zero-flux face use the tangential tensor
-// under n.sigma grad u = 0 (second order at the wall). At a Dirichlet face the boundary flux
-// omits sigma_nt dg/dt (first order there when g varies along a face with sigma_nt != 0; the
-// matrix stays symmetric). The weights of an owned cell are the same numbers for the explicit
-// sweep (apply_row) and for the matrix assembly (weights), so L u + b is the explicit operator.
+// of the second-order scheme crosses a zero-flux face; dual cells straddling a zero-flux face use
+// the tangential tensor under n.sigma grad u = 0 (second order at the wall). At a Dirichlet face
+// the boundary flux omits sigma_nt dg/dt (first order there when g varies along a face with
+// sigma_nt != 0; the matrix stays symmetric). The weights of an owned cell are the same numbers for
+// the explicit sweep (apply_row) and for the matrix assembly (weights), so L u + b is the explicit
+// operator.
 #pragma once
 
 #include "grid/halo.hpp"
-#include "operators/diffusion_kernel.hpp"
 #include "grid/stencil.hpp"
+#include "operators/diffusion_kernel.hpp"
 
 #include <vector>
 
@@ -64,11 +67,11 @@ private:
   const Grid& grid_;
   DiffusionScheme scheme_;
   double D_ = 0, lmax_ = 0, radius_ = 0;
-  Stencil stencil_;                      // Constant: the run's stencil (unscaled)
+  Stencil stencil_;                       // Constant: the run's stencil (unscaled)
   std::vector<std::vector<double>> coef_; // ghosted layout
   std::vector<std::vector<double>> dual_; // Tensor: dual-cell tensors by lower cell
-  std::vector<long> delta_;              // ghosted-array offset of each box neighbour
-  long st_[3] = {1, 0, 0};               // ghosted-array stride per axis
+  std::vector<long> delta_;               // ghosted-array offset of each box neighbour
+  long st_[3] = {1, 0, 0};                // ghosted-array stride per axis
   double inv_h_[3] = {1, 1, 1};
   double iso_radius_ = 0; // spectral radius of the 5/7-point Laplacian
 };

@@ -27,7 +27,8 @@ OperatorMatrices::OperatorMatrices(const Grid& grid, const Halo& halo, const Ste
       double w[27];
       op.weights(i, j, k, w);
       for (int t = 0; t < nb; ++t)
-        if (w[t] != 0.0) out.push_back({{t % 3 - 1, (t / 3) % 3 - 1, nb == 27 ? t / 9 - 1 : 0}, w[t]});
+        if (w[t] != 0.0)
+          out.push_back({{t % 3 - 1, (t / 3) % 3 - 1, nb == 27 ? t / 9 - 1 : 0}, w[t]});
     };
     mat_.push_back(std::make_shared<LaplacianMatrix>(grid, halo, terms, 1, dir ? &own : nullptr));
     index_.push_back(0);

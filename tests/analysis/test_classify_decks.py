@@ -2,8 +2,8 @@
 its summary.json (written at the end of every run: pattern class per species from the final
 field and 1,000 samples of the run) must give the class its header describes: Sanderson et al.
 Figs. 1 and 3, Garrity's four Gray-Scott presets, Pearson's spots, a Barkley spiral and the
-Brusselator's hexagons. Classes of spots refer to the species: Turing's spots are high in b,
-so the same run is `holes` in a."""
+Brusselator's hexagons (the diffusion-tensor decks: test_classify_tensor_decks.py). Classes of
+spots refer to the species: Turing's spots are high in b, so the same run is `holes` in a."""
 import json
 import os
 import sys
@@ -26,13 +26,31 @@ EXPECTED = {
 }
 
 
+@pytest.fixture(scope="module")
+def deck_run(tmp_path_factory):
+    """deck name -> the output directory of its full-length run on 2 ranks (run once)."""
+    runs = {}
+
+    def get(deck):
+        if deck not in runs:
+            cwd = tmp_path_factory.mktemp(deck)
+            r = run([os.path.join(SOURCE, "input", deck + ".yaml"), "-output_dir", "o",
+                     "-png_every", "0"], cwd, 2, timeout=900)
+            assert r.returncode == 0, r.stdout[-1500:] + r.stderr[-1500:]
+            runs[deck] = cwd / "o"
+        return runs[deck]
+
+    return get
+
+
+def summary(out):
+    with open(out / "summary.json") as f:
+        return json.load(f)
+
+
 @pytest.mark.parametrize("deck", sorted(EXPECTED))
-def test_deck_class(tmp_path, deck):
-    r = run([os.path.join(SOURCE, "input", deck + ".yaml"), "-output_dir", "o", "-png_every",
-             "0", "-checkpoint_final", "false"], tmp_path, 2, timeout=900)
-    assert r.returncode == 0, r.stdout[-1500:] + r.stderr[-1500:]
-    with open(tmp_path / "o/summary.json") as f:
-        s = json.load(f)
+def test_deck_class(deck_run, deck):
+    s = summary(deck_run(deck))
     for species, cls in EXPECTED[deck].items():
         got = s["species"][species]
         assert got["class"] == cls, f"{deck} {species}: {got['class']} ({got['reason']})"

@@ -1,7 +1,7 @@
 // Laplacian stencils: exact on quadratics (second order), spectral radius at the Nyquist
 // corner, and the explicit stability bound dt <= h^2 / (2 dim D) for 5/7-point stencils.
-#include "integrators/explicit_integrator.hpp"
 #include "grid/stencil.hpp"
+#include "integrators/explicit_integrator.hpp"
 
 #include <gtest/gtest.h>
 

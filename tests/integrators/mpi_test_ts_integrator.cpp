@@ -176,8 +176,8 @@ std::unique_ptr<Problem> make_problem(MPI_Comm comm, const ProblemSpec& ps) {
     VecRestoreArray(p->u.back(), &a);
   }
   const std::vector<double> floor = ps.floor.empty() ? std::vector<double>(ns, -kInf) : ps.floor;
-  p->ts = std::make_unique<TsIntegrator>(*p->grid, model->rates, species, p->params, floor,
-                                         *p->lap, p->sources.get(), ps.dt);
+  p->ts = std::make_unique<TsIntegrator>(*p->grid, model->rates, species, p->params, floor, *p->lap,
+                                         p->sources.get(), ps.dt);
   return p;
 }
 
@@ -481,10 +481,9 @@ TEST(TsIntegrator, DirichletLinearSteadyState) {
   for (auto& f : p->dirichlet)
     std::fill(f.face[1].begin(), f.face[1].end(), 3.0);
   p->build_matrices(ps.D, &p->dirichlet);
-  p->ts = std::make_unique<TsIntegrator>(*p->grid, find_model("turing")->rates,
-                                         std::vector<std::string>{"a", "b"}, p->params,
-                                         std::vector<double>{-kInf, -kInf}, *p->lap, nullptr,
-                                         ps.dt);
+  p->ts = std::make_unique<TsIntegrator>(
+      *p->grid, find_model("turing")->rates, std::vector<std::string>{"a", "b"}, p->params,
+      std::vector<double>{-kInf, -kInf}, *p->lap, nullptr, ps.dt);
   p->run(100, ps.dt);
   for (int s = 0; s < 2; ++s)
     EXPECT_LT(p->max_error(s, [](double x, double) { return 1 + 2 * x / 16; }), 1e-8);

@@ -1,31 +1,19 @@
-// morphogen: MPI-distributed reaction-diffusion (Turing pattern) solver.
-//
-//   morphogen [DECK.yaml] [-option value ...]
-//   morphogen sweep DECK.yaml [-option value ...]     (phase-diagram sweep, sweep/sweep_main.hpp)
-//
-// Loads the deck (or the embedded default, Sanderson Fig. 1) into PETSc's options database,
-// overrides it with the command line, validates every option (unknown options fail with a
-// "did you mean"), writes options_used.yaml and runs, writing snapshots and checkpoints.
-// Exit codes: 0 success, 1 bad input or a diverged run (one-line message), 2 an internal PETSc
-// error (PETSc prints its trace), 3 stopped by SIGUSR1/SIGTERM or -max_walltime after writing a
-// checkpoint (resubmit with -restart latest), 4 an output file could not be written.
+#include "app/run_main.hpp"
+
 #include "app/deck.hpp"
 #include "app/restart.hpp"
 #include "app/run_loop.hpp"
 #include "app/simulation.hpp"
 #include "core/collective_error.hpp"
-#include "core/stop_signal.hpp"
 #include "core/user_error.hpp"
-#include "sweep/sweep_main.hpp"
 
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <memory>
 #include <optional>
 #include <vector>
 
-using namespace morphogen;
+namespace morphogen {
 
 namespace {
 
@@ -83,7 +71,9 @@ void print_header(MPI_Comm comm, const Simulation& sim, int level, int levels) {
               size == 1 ? "" : "s", sim.output().dir.c_str());
 }
 
-int run(int* argc, char*** argv, double wall_start) {
+} // namespace
+
+int run_main(int* argc, char*** argv, double wall_start) {
   MPI_Comm comm = PETSC_COMM_WORLD;
   const std::string base_dir = load_deck(argc, argv);
   Options opt(comm);
@@ -175,30 +165,4 @@ int run(int* argc, char*** argv, double wall_start) {
   return 0;
 }
 
-} // namespace
-
-int main(int argc, char** argv) {
-  PetscCall(PetscInitialize(&argc, &argv, nullptr,
-                            "morphogen [DECK.yaml] [-option value ...]; -help lists options\n"));
-  install_stop_signal_handlers();
-  const double wall_start = MPI_Wtime(); // -max_walltime counts from here
-  int rc = 0;
-  try {
-    rc = argc > 1 && std::string(argv[1]) == "sweep" ? sweep::run_sweep(&argc, &argv)
-                                                     : run(&argc, &argv, wall_start);
-  } catch (const UserError& e) {
-    PetscFPrintf(PETSC_COMM_WORLD, PETSC_STDERR, "morphogen: error: %s\n", e.what());
-    rc = 1;
-  } catch (const PetscFailure&) {
-    // PETSc printed its trace; the failure may be on this rank only, so abort the job rather
-    // than wait for the other ranks in PetscFinalize.
-    MPI_Abort(PETSC_COMM_WORLD, 2);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "morphogen: internal error: %s\n", e.what());
-    MPI_Abort(PETSC_COMM_WORLD, 2);
-  }
-  // Unused-option warnings are ours (check_unused); keep PETSc quiet about them at exit.
-  PetscCall(PetscOptionsSetValue(nullptr, "-options_left", "0"));
-  PetscCall(PetscFinalize());
-  return rc;
-}
+} // namespace morphogen

@@ -1,0 +1,48 @@
+// morphogen: MPI-distributed reaction-diffusion (Turing pattern) solver.
+//
+//   morphogen [DECK.yaml] [-option value ...]           (one run, app/run_main.hpp)
+//   morphogen sweep DECK.yaml [-option value ...]     (phase-diagram sweep, sweep/sweep_main.hpp)
+//
+// The entry point: the top layer, above app and sweep (which sits on app), so neither of them
+// needs to know about the other. Exit codes: 0 success, 1 bad input or a diverged run (one-line
+// message), 2 an internal PETSc error (PETSc prints its trace), 3 stopped by SIGUSR1/SIGTERM or
+// -max_walltime after writing a checkpoint (resubmit with -restart latest), 4 an output file
+// could not be written.
+#include "app/run_main.hpp"
+#include "core/collective_error.hpp"
+#include "core/petsc_handle.hpp"
+#include "core/stop_signal.hpp"
+#include "core/user_error.hpp"
+#include "sweep/sweep_main.hpp"
+
+#include <cstdio>
+#include <exception>
+#include <string>
+
+using namespace morphogen;
+
+int main(int argc, char** argv) {
+  PetscCall(PetscInitialize(&argc, &argv, nullptr,
+                            "morphogen [DECK.yaml] [-option value ...]; -help lists options\n"));
+  install_stop_signal_handlers();
+  const double wall_start = MPI_Wtime(); // -max_walltime counts from here
+  int rc = 0;
+  try {
+    rc = argc > 1 && std::string(argv[1]) == "sweep" ? sweep::run_sweep(&argc, &argv)
+                                                     : run_main(&argc, &argv, wall_start);
+  } catch (const UserError& e) {
+    PetscFPrintf(PETSC_COMM_WORLD, PETSC_STDERR, "morphogen: error: %s\n", e.what());
+    rc = 1;
+  } catch (const PetscFailure&) {
+    // PETSc printed its trace; the failure may be on this rank only, so abort the job rather
+    // than wait for the other ranks in PetscFinalize.
+    MPI_Abort(PETSC_COMM_WORLD, 2);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "morphogen: internal error: %s\n", e.what());
+    MPI_Abort(PETSC_COMM_WORLD, 2);
+  }
+  // Unused-option warnings are ours (check_unused); keep PETSc quiet about them at exit.
+  PetscCall(PetscOptionsSetValue(nullptr, "-options_left", "0"));
+  PetscCall(PetscFinalize());
+  return rc;
+}
