@@ -11,7 +11,10 @@ import sys
 import pytest
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "app"))
-from conftest import SOURCE, run  # noqa: E402
+from conftest import run  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(__file__))
+from deck_runs import deck_runner, summary  # noqa: E402
 
 EXPECTED = {
     "turing_spots": {"a": "holes", "b": "spots"},               # Sanderson Fig. 1
@@ -28,24 +31,8 @@ EXPECTED = {
 
 @pytest.fixture(scope="module")
 def deck_run(tmp_path_factory):
-    """deck name -> the output directory of its full-length run on 2 ranks (run once)."""
-    runs = {}
+    return deck_runner(tmp_path_factory)
 
-    def get(deck):
-        if deck not in runs:
-            cwd = tmp_path_factory.mktemp(deck)
-            r = run([os.path.join(SOURCE, "input", deck + ".yaml"), "-output_dir", "o",
-                     "-png_every", "0"], cwd, 2, timeout=900)
-            assert r.returncode == 0, r.stdout[-1500:] + r.stderr[-1500:]
-            runs[deck] = cwd / "o"
-        return runs[deck]
-
-    return get
-
-
-def summary(out):
-    with open(out / "summary.json") as f:
-        return json.load(f)
 
 
 @pytest.mark.parametrize("deck", sorted(EXPECTED))

@@ -9,7 +9,6 @@ Where a class is not the whole promise, the final checkpoint is measured
 second-order tensor schemes, spots following a tensor field, uniform spots on a torus, and the
 stretch of a 3-D pattern. Each deck runs once per session (the class and the promise tests share
 the run)."""
-import json
 import math
 import os
 import sys
@@ -18,7 +17,10 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "app"))
-from conftest import SOURCE, run  # noqa: E402
+from conftest import SOURCE  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(__file__))
+from deck_runs import deck_runner, summary  # noqa: E402
 
 sys.path.insert(0, os.path.join(SOURCE, "postproc"))
 import spot_shapes  # noqa: E402
@@ -38,24 +40,8 @@ EXPECTED = {
 
 @pytest.fixture(scope="module")
 def deck_run(tmp_path_factory):
-    """deck name -> the output directory of its full-length run on 2 ranks (run once)."""
-    runs = {}
+    return deck_runner(tmp_path_factory)
 
-    def get(deck):
-        if deck not in runs:
-            cwd = tmp_path_factory.mktemp(deck)
-            r = run([os.path.join(SOURCE, "input", deck + ".yaml"), "-output_dir", "o",
-                     "-png_every", "0"], cwd, 2, timeout=900)
-            assert r.returncode == 0, r.stdout[-1500:] + r.stderr[-1500:]
-            runs[deck] = cwd / "o"
-        return runs[deck]
-
-    return get
-
-
-def summary(out):
-    with open(out / "summary.json") as f:
-        return json.load(f)
 
 
 def final_field(out, species):
