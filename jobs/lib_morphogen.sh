@@ -391,10 +391,22 @@ mg_run() {
   MG_PROGRESS_BEFORE=$("$MG_PROGRESS" "$MG_OUT")
   mg_note "segment $((MG_COUNT + 1)) of at most $((MG_MAX + 1)) starts${MG_PROGRESS_BEFORE:+ from $MG_PROGRESS_BEFORE}: $(mg_quote "${MG_LAUNCHER[@]}" "${MG_CMD[@]}")"
 
+  # The ranks' own exit code: rank 0 writes it to MORPHOGEN_EXIT_FILE on the way out, because
+  # the launcher's may differ (Open MPI's mpiexec returns 1 when SIGTERM reached it, although
+  # the ranks checkpointed and exited 3).
+  MG_EXIT_FILE=$MG_OUT/.morphogen_exit_code
+  rm -f -- "$MG_EXIT_FILE"
+  # hwloc's OpenCL and GL plugins (an OpenCL ICD such as PoCL loads LLVM, whose SIGUSR1 handler
+  # replaces mpiexec's forwarding) would keep the forwarded SIGUSR1 from reaching the ranks.
+  export HWLOC_COMPONENTS=${HWLOC_COMPONENTS--opencl,-gl}
+  # When the batch system's SIGTERM reaches Open MPI's mpiexec itself, it kills the ranks 1 s
+  # later (odls_base_sigkill_timeout), mid-checkpoint: give them time to finish it.
+  export OMPI_MCA_odls_base_sigkill_timeout=${OMPI_MCA_odls_base_sigkill_timeout-30}
+
   MG_TRAPPED=0 MG_GOT_TERM=0 MG_PENDING=0 MG_CHILD=""
   trap 'mg__on_signal USR1' USR1
   trap 'mg__on_signal TERM' TERM
-  "${MG_LAUNCHER[@]}" "${MG_CMD[@]}" &
+  MORPHOGEN_EXIT_FILE=$MG_EXIT_FILE "${MG_LAUNCHER[@]}" "${MG_CMD[@]}" &
   MG_CHILD=$!
   if ((MG_PENDING)); then
     kill -USR1 "$MG_CHILD" 2>/dev/null || true
@@ -419,6 +431,20 @@ mg_run() {
   trap 'mg_log "received SIGUSR1 after the run ended"' USR1
   trap 'mg_log "received SIGTERM after the run ended"; MG_GOT_TERM=1' TERM
   MG_RC=$rc
+  mg__ranks_exit_code
+}
+
+# If the ranks wrote their exit code (MG_EXIT_FILE) and it differs from the launcher's, use
+# theirs: a checkpoint-and-exit-3 must resubmit whatever the launcher made of it.
+mg__ranks_exit_code() {
+  local code=""
+  [[ -r $MG_EXIT_FILE ]] && read -r code <"$MG_EXIT_FILE"
+  rm -f -- "$MG_EXIT_FILE"
+  mg_is_uint "$code" || return 0
+  if ((10#$code != MG_RC)); then
+    mg_log "the launcher returned $MG_RC, the ranks exited with $((10#$code)): using $((10#$code))"
+    MG_RC=$((10#$code))
+  fi
 }
 
 # Whether a run that stopped with exit code 3 may be resubmitted; prints the reason if not. A

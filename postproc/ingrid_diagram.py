@@ -442,7 +442,7 @@ def draw_turing_overlay(ax, axes, options, extent):
     tr = np.ma.masked_invalid(trace)
     if tr.count() and tr.min() < 0 < tr.max():
         ax.contour(X, Y, tr, levels=[0.0], colors="white", linewidths=1.4, linestyles="dashed")
-        handles.append(Line2D([], [], color="white", lw=1.4, ls="--", label="Hopf (trace J = 0)"))
+        handles.append(Line2D([], [], color="white", lw=1.4, ls="--", label="Hopf (trace J = 0, det J > 0)"))
         drawn.append("Hopf")
     if not handles:
         return "no stability boundary in range"

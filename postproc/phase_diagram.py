@@ -305,7 +305,7 @@ class Sweep:
             m = [len(a) for a in axes]
             shape = tuple(reversed(m))
             out = {"m": m}
-            for key in ("turing", "hopf"):
+            for key in ("turing", "hopf", "hopf_region"):
                 v = sm.get(key)
                 if isinstance(v, list) and len(v) == int(np.prod(m)):
                     out[key] = np.asarray([bool(b) for b in v]).reshape(shape)
@@ -517,7 +517,9 @@ def draw_boundary(ax, sweep, key, ip, colour, style):
         return False
     kw = dict(colors=colour, linewidths=2.0, linestyles=style)
     if m.shape[0] >= 2 and m.shape[1] >= 2:
-        ax.contour(ux, uy, m, levels=[0.5], **kw)
+        cs = ax.contour(ux, uy, m, levels=[0.5], **kw)
+        for c in cs.collections:  # stay inside the panel
+            c.set_clip_path(ax.patch)
         return True
     # a 1-D map: lines where the flag changes, across the strip
     line = m.ravel()
@@ -548,7 +550,11 @@ def write_class_map(sweep, path, cell=None):
         ax.imshow(img, origin="lower", extent=extent(sweep), aspect="auto",
                   interpolation="nearest")
         drawn["turing"] |= draw_boundary(ax, sweep, "turing", ip, TURING_COLOUR, "solid")
-        drawn["hopf"] |= draw_boundary(ax, sweep, "hopf", ip, HOPF_COLOUR, "dashed")
+        # the Hopf line (trace J = 0 where det J > 0): the edge of "hopf_region"; sweep.json files
+        # written before it existed only have "hopf" (a complex pair with Re > 0), whose edge
+        # also follows trace^2 = 4 det, which is not a stability boundary
+        hopf_key = "hopf_region" if sweep.stability and "hopf_region" in sweep.stability else "hopf"
+        drawn["hopf"] |= draw_boundary(ax, sweep, hopf_key, ip, HOPF_COLOUR, "dashed")
         label_axes(ax, sweep, pw, ph, ylabel=ip % PANEL_COLUMNS == 0)
         panel_title(ax, sweep, ip)
     counts = sweep.classes()

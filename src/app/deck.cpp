@@ -1,53 +1,178 @@
 #include "app/deck.hpp"
 
+#include "app/model_decks.hpp"
+#include "core/options.hpp"
 #include "core/petsc_handle.hpp"
 #include "core/user_error.hpp"
 
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <sstream>
+#include <yaml-cpp/yaml.h>
+
+// GCC 12 warns about yaml-cpp 0.7's node iterators (impl.h) instantiated here: a false positive.
+#if defined(__GNUC__) && !defined(__clang__) && __GNUC__ >= 12
+#pragma GCC diagnostic ignored "-Wdangling-pointer"
+#endif
 
 namespace morphogen {
 
-std::string load_deck(int* argc, char*** argv) {
-  std::string deck, base_dir;
-  if (*argc > 1 && (*argv)[1][0] != '-') deck = (*argv)[1];
-  // A deck anywhere else would be taken by PETSc as an option value or ignored: refuse it.
-  for (int i = 2; i < *argc; ++i) {
-    const std::string a = (*argv)[i];
-    const auto ends = [&](const std::string& e) {
-      return a.size() > e.size() && a.compare(a.size() - e.size(), e.size(), e) == 0;
-    };
-    const std::string prev = (*argv)[i - 1];
+namespace {
+
+bool ends_with(const std::string& a, const std::string& e) {
+  return a.size() > e.size() && a.compare(a.size() - e.size(), e.size(), e) == 0;
+}
+
+// "name:line:column" of a yaml-cpp mark (0-based there, 1-based here).
+std::string at(const std::string& name, const YAML::Mark& m) {
+  return name + ":" + std::to_string(m.line + 1) + ":" + std::to_string(m.column + 1);
+}
+
+// Line and column (1-based) of byte `pos` in text.
+std::string at_offset(const std::string& name, const std::string& text, size_t pos) {
+  size_t line = 1, col = 1;
+  for (size_t i = 0; i < pos && i < text.size(); ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      col = 1;
+    } else {
+      ++col;
+    }
+  }
+  return name + ":" + std::to_string(line) + ":" + std::to_string(col);
+}
+
+// Walks a mapping; every key must be a plain name, given once (also once after nested keys are
+// joined with '_' into option names, which `seen` collects across the whole deck).
+std::string check_map(const YAML::Node& map, const std::string& prefix, const std::string& name,
+                      std::map<std::string, YAML::Mark>& seen) {
+  for (auto it = map.begin(); it != map.end(); ++it) {
+    const YAML::Node& key = it->first;
+    if (!key.IsScalar() || key.Scalar().empty())
+      return at(name, key.Mark()) + ": a key must be a name (key: value)";
+    const std::string option = prefix.empty() ? key.Scalar() : prefix + "_" + key.Scalar();
+    const YAML::Node& value = it->second;
+    if (value.IsMap()) {
+      if (const std::string e = check_map(value, option, name, seen); !e.empty()) return e;
+      continue;
+    }
+    const auto [prev, fresh] = seen.emplace(option, key.Mark());
+    if (!fresh)
+      return at(name, key.Mark()) + ": duplicate key " + key.Scalar() + " (option -" + option +
+             ", already given at line " + std::to_string(prev->second.line + 1) + ")";
+  }
+  return {};
+}
+
+std::string read_file(const std::string& path, const std::string& option) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw UserError(option + path + ": no such file");
+  std::ifstream f(path, std::ios::binary);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  if (!f) throw UserError(option + path + ": cannot be read");
+  return ss.str();
+}
+
+// Inserts a checked file with PETSc; its refusal (unexpected after the checks) is one line.
+void insert_file(const std::string& option, const std::string& path, bool yaml) {
+  const std::string err = petsc_quietly([&] {
+    return yaml ? PetscOptionsInsertFileYAML(PETSC_COMM_WORLD, nullptr, path.c_str(), PETSC_TRUE)
+                : PetscOptionsInsertFile(PETSC_COMM_WORLD, nullptr, path.c_str(), PETSC_TRUE);
+  });
+  if (!err.empty())
+    throw UserError(option + path + ": not a valid " + (yaml ? "YAML deck" : "options file") +
+                    " (" + one_line(err) + ")");
+}
+
+// A YAML file: checked with yaml-cpp, then inserted. `option` prefixes messages ("deck ",
+// "-options_file ").
+void insert_yaml(const std::string& option, const std::string& path) {
+  const std::string err = check_deck_text(read_file(path, option), path);
+  if (!err.empty()) throw UserError(option.substr(0, option.size() - 1) + " " + err);
+  insert_file(option, path, true);
+}
+
+// -options_file / -options_file_yaml: YAML when so named or when the file ends in .yaml/.yml
+// (as PETSc decides), else PETSc's plain "-option value" format.
+void insert_options_file(const OptionsFileArg& f) {
+  const std::string option = "-" + f.option + " ";
+  if (f.option == "options_file_yaml" || ends_with(f.path, ".yaml") || ends_with(f.path, ".yml"))
+    return insert_yaml(option, f.path);
+  const std::string err = check_options_file_text(read_file(f.path, option), f.path);
+  if (!err.empty()) throw UserError(option.substr(0, option.size() - 1) + " " + err);
+  insert_file(option, f.path, false);
+}
+
+// A deck anywhere but first would be taken by PETSc as an option value or ignored: refuse it.
+void refuse_late_deck(int argc, char** argv) {
+  for (int i = 2; i < argc; ++i) {
+    const std::string a = argv[i];
+    const std::string prev = argv[i - 1];
     const bool is_value = prev.size() > 1 && prev[0] == '-' && prev != "-options_file" &&
                           prev != "-options_file_yaml";
-    if ((ends(".yaml") || ends(".yml")) && !is_value)
+    if ((ends_with(a, ".yaml") || ends_with(a, ".yml")) && !is_value)
       throw UserError("deck " + a +
                       ": the deck must be the first argument (morphogen DECK.yaml "
                       "[-option value ...])");
   }
+}
+
+} // namespace
+
+std::string check_deck_text(const std::string& text, const std::string& name) {
+  if (const size_t nul = text.find('\0'); nul != std::string::npos)
+    return at_offset(name, text, nul) + ": NUL byte (a deck is YAML text)";
+  std::vector<YAML::Node> docs;
+  try {
+    docs = YAML::LoadAll(text);
+  } catch (const YAML::Exception& e) {
+    return at(name, e.mark) + ": YAML syntax error: " + e.msg;
+  }
+  if (docs.empty() || (docs.size() == 1 && docs[0].IsNull()))
+    return name + ":1:1: empty deck (no keys, only comments or blank lines)";
+  if (docs.size() > 1)
+    return at(name, docs[1].Mark()) +
+           ": a second YAML document (after '---'); a deck is one document";
+  if (!docs[0].IsMap())
+    return at(name, docs[0].Mark()) + ": a deck is a mapping of keys (key: value)";
+  std::map<std::string, YAML::Mark> seen;
+  return check_map(docs[0], "", name, seen);
+}
+
+std::string check_options_file_text(const std::string& text, const std::string& name) {
+  std::istringstream in(text);
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    const std::string where = name + ":" + std::to_string(n);
+    if (line.find('\0') != std::string::npos) return where + ": NUL byte (not a text file)";
+    std::istringstream words(line.substr(0, line.find('#')));
+    std::string first;
+    if (!(words >> first)) continue;
+    if (first == "alias") continue;
+    if (first.size() < 2 || first[0] != '-')
+      return where + ": expected -option [value], got '" + first + "'";
+  }
+  return {};
+}
+
+std::string load_deck(int* argc, char*** argv, const std::vector<OptionsFileArg>& files) {
+  std::string deck, base_dir;
+  if (*argc > 1 && (*argv)[1][0] != '-') deck = (*argv)[1];
+  refuse_late_deck(*argc, *argv);
   if (!deck.empty()) {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(deck, ec))
-      throw UserError("deck " + deck + ": no such file");
-    std::ifstream probe(deck);
-    if (!probe) throw UserError("deck " + deck + ": cannot be read");
-    const std::string err = petsc_quietly([&] {
-      return PetscOptionsInsertFileYAML(PETSC_COMM_WORLD, nullptr, deck.c_str(), PETSC_TRUE);
-    });
-    if (!err.empty()) throw UserError("deck " + deck + ": not a valid YAML deck (" + err + ")");
+    insert_yaml("deck ", deck);
     base_dir = std::filesystem::path(deck).parent_path().string();
   } else {
-    // The default deck is Sanderson Fig. 1: it applies unless an options file is given or a
-    // different model is chosen (then the model's own defaults apply).
-    PetscBool f1 = PETSC_FALSE, f2 = PETSC_FALSE, has_model = PETSC_FALSE;
-    char model[256] = "";
-    MG_PETSC(PetscOptionsHasName(nullptr, nullptr, "-options_file", &f1));
-    MG_PETSC(PetscOptionsHasName(nullptr, nullptr, "-options_file_yaml", &f2));
-    MG_PETSC(PetscOptionsGetString(nullptr, nullptr, "-model", model, sizeof model, &has_model));
-    const bool other_model = has_model && std::string(model) != "turing";
-    if (!f1 && !f2 && !other_model) MG_PETSC(PetscOptionsInsertStringYAML(nullptr, kDefaultDeck));
+    // The default deck of the chosen model (turing: Sanderson Fig. 1), unless an options file
+    // is given (app/model_decks.hpp).
+    if (files.empty()) insert_model_default_deck();
   }
-  // The command line (and any -options_file) overrides the deck.
+  for (const auto& f : files)
+    insert_options_file(f);
+  // The command line overrides the deck and the options files.
   MG_PETSC(PetscOptionsInsert(nullptr, argc, argv, nullptr));
   return base_dir;
 }

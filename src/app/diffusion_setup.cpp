@@ -145,8 +145,7 @@ DiffusionSetup read_diffusion(Options& opt, const Grid& grid, const Halo& halo,
     char* end = nullptr;
     const double v = std::strtod(dtext.c_str(), &end);
     if (end && end != dtext.c_str() && *end == '\0' && !(v >= 0 && v <= kMaxReal))
-      throw UserError("-" + dkey + " " + dtext + ": out of range, allowed [0, " +
-                      format_double(kMaxReal) + "]");
+      throw UserError("-" + dkey + " " + dtext + ": out of range, " + allowed_range(0, kMaxReal));
   }
   ValueSpec D(dkey, dtext, spec, seed, base_dir);
   if (D.uses_time())
@@ -155,8 +154,8 @@ DiffusionSetup read_diffusion(Options& opt, const Grid& grid, const Halo& halo,
   if (D.is_constant() && !tensor) {
     const double v = D.constant_value();
     if (!(v >= 0 && v <= kMaxReal))
-      throw UserError("-" + dkey + " " + D.text() + ": out of range, allowed [0, " +
-                      format_double(kMaxReal) + "]");
+      throw UserError("-" + dkey + " " + D.text() + ": out of range, " +
+                      allowed_range(0, kMaxReal));
     out.op = std::make_unique<DiffusionOperator>(grid, stencil, v);
     out.D_mean = v;
     return out;

@@ -6,6 +6,9 @@
 #include "core/user_error.hpp"
 #include "io/slice_gather.hpp"
 
+#include <hdf5.h>
+#include <petscsys.h>
+
 #include <algorithm>
 #include <cmath>
 #include <optional>
@@ -250,6 +253,25 @@ nlohmann::json samples_json(const analysis::RunSamples& s) {
           {"stddev", arr(s.stddev)},
           {"change", arr(s.change)},
           {"probe", arr(s.probe)}};
+}
+
+nlohmann::json run_record(double wall_seconds, double cell_updates, double loop_seconds,
+                          int ranks) {
+  char petsc[256] = {};
+  PetscGetVersion(petsc, sizeof petsc);
+  std::string pv = petsc;
+  while (!pv.empty() && pv.back() == ' ')
+    pv.pop_back();
+  unsigned maj = 0, min = 0, rel = 0;
+  H5get_libversion(&maj, &min, &rel);
+  const std::string hv =
+      std::to_string(maj) + "." + std::to_string(min) + "." + std::to_string(rel);
+  return {{"wall_time_s", num(wall_seconds)},
+          {"loop_time_s", num(loop_seconds)},
+          {"cell_updates", num(cell_updates)},
+          {"cell_updates_per_s", num(loop_seconds > 0 ? cell_updates / loop_seconds : NAN)},
+          {"ranks", ranks},
+          {"versions", {{"morphogen", MORPHOGEN_VERSION}, {"petsc", pv}, {"hdf5", hv}}}};
 }
 
 } // namespace morphogen

@@ -45,6 +45,11 @@ nlohmann::json stability_record(const Simulation& sim);
 
 nlohmann::json samples_json(const analysis::RunSamples& s);
 
+// The run's cost and provenance for summary.json: wall time (seconds since the program
+// started), the time-stepping rate (cell-updates per second of the time loop), the rank count
+// and the versions of morphogen, PETSc and HDF5.
+nlohmann::json run_record(double wall_seconds, double cell_updates, double loop_seconds, int ranks);
+
 // Linear stability of (params, D): every homogeneous steady state that find_steady_states
 // finds, plus the model's own, is analysed; the one reported is the first Turing-unstable
 // state, else the first with a Hopf instability, else the model's own steady state (so a

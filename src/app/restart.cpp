@@ -1,11 +1,13 @@
 #include "app/restart.hpp"
 
 #include "core/collective_error.hpp"
+#include "core/options.hpp"
 #include "core/user_error.hpp"
 #include "io/checkpoint_files.hpp"
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 namespace morphogen {
 
@@ -17,6 +19,46 @@ std::string check_complete(const io::ImageInfo& info) {
   const long long* complete = a.integer("complete");
   if (!complete || *complete != 1 || !a.real("time") || !a.integer("step") || !a.integer("level"))
     return "no complete /morphogen restart record (a snapshot, or an interrupted write)";
+  return {};
+}
+
+// "" if every attribute of a complete checkpoint is in range, else "attribute NAME = VALUE:
+// allowed ..." for the first one that is not (a NaN time would otherwise reach the JSON
+// broadcast, a negative step would run and retire the checkpoint chain).
+std::string check_attributes(const io::ImageInfo& info) {
+  const auto& a = info.attributes;
+  const auto real = [&](const char* name, double lo, bool open_lo, bool required) -> std::string {
+    const double* v = a.real(name);
+    if (!v) return required ? std::string("attribute /morphogen/") + name + " missing" : "";
+    if (std::isfinite(*v) && (open_lo ? *v > lo : *v >= lo)) return {};
+    return std::string("attribute /morphogen/") + name + " = " + format_number(*v) +
+           ": allowed a finite number " + (open_lo ? "> " : ">= ") + format_number(lo);
+  };
+  const auto integer = [&](const char* name, long long lo, long long hi) -> std::string {
+    const long long* v = a.integer(name);
+    if (!v || (*v >= lo && *v <= hi)) return {};
+    return std::string("attribute /morphogen/") + name + " = " + std::to_string(*v) + ": allowed " +
+           (hi == std::numeric_limits<long long>::max()
+                ? ">= " + std::to_string(lo)
+                : "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  };
+  constexpr long long big = std::numeric_limits<long long>::max();
+  for (const std::string& e :
+       {real("time", 0, false, true), real("dt", 0, true, false), integer("step", 0, big),
+        integer("level", 0, 7), integer("nranks", 1, big), integer("seed", 0, big)})
+    if (!e.empty()) return e;
+  for (int d = 0; d < 3; ++d) {
+    const std::string axis = std::string(1, "xyz"[d]);
+    if (info.n[d] < 1)
+      return "/VTKHDF WholeExtent: " + std::to_string(info.n[d]) + " cells along " + axis +
+             ", allowed >= 1";
+    if (!std::isfinite(info.origin[d]))
+      return "/VTKHDF Origin " + axis + " = " + format_number(info.origin[d]) +
+             ": allowed a finite number";
+    if (!(std::isfinite(info.spacing[d]) && info.spacing[d] > 0))
+      return "/VTKHDF Spacing " + axis + " = " + format_number(info.spacing[d]) +
+             ": allowed a finite number > 0";
+  }
   return {};
 }
 
@@ -57,12 +99,15 @@ std::optional<RestartPoint> locate_restart(MPI_Comm comm, const std::string& spe
         auto info = io::inspect_vtkhdf(p, why);
         if (info) why = check_complete(*info);
         if (info && why.empty()) {
-          // A complete checkpoint of another model is a mistake, not a reason to start over
-          // (which would retire the whole chain).
-          const std::string wrong = check_model(*info, model);
-          if (!wrong.empty()) err = "-restart latest: " + p + ": " + wrong;
+          // A complete checkpoint of another model, or with attributes out of range, is a
+          // mistake, not a reason to start over (which would retire the whole chain).
+          std::string wrong = check_attributes(*info);
+          if (wrong.empty()) wrong = check_model(*info, model);
           path = p;
-          json = info->to_json();
+          if (!wrong.empty())
+            err = "-restart latest: " + p + ": " + wrong;
+          else
+            json = info->to_json();
           break;
         }
         std::fprintf(stderr, "morphogen: warning: -restart latest: skipping %s: %s\n", p.c_str(),
@@ -75,12 +120,13 @@ std::optional<RestartPoint> locate_restart(MPI_Comm comm, const std::string& spe
     } else {
       auto info = io::inspect_vtkhdf(spec, why);
       if (info) why = check_complete(*info);
+      if (info && why.empty()) why = check_attributes(*info);
       if (info && why.empty()) why = check_model(*info, model);
       if (!info || !why.empty())
         err = "-restart " + spec + ": not a usable checkpoint: " + why +
               " (allowed: a checkpoint_*.vtkhdf file or 'latest')";
       path = spec;
-      if (info) json = info->to_json();
+      if (info && err.empty()) json = info->to_json();
     }
     std::fflush(stdout);
   }

@@ -3,7 +3,10 @@
 //
 // A checkpoint is accepted when HDF5 opens it (a truncated file is not), it is VTKHDF ImageData
 // with every species of the model and a /morphogen group with complete = 1, time, step and
-// level, and its model, extents and spacing match this run's level. With `latest`, unusable
+// level, every attribute is in range (time finite >= 0, dt finite > 0, step >= 0, level in
+// [0, 7], nranks >= 1, seed >= 0, origin finite, spacing finite > 0; else a UserError naming the
+// file and the attribute, also with `latest`), and its model, extents and spacing match this
+// run's level. With `latest`, unusable
 // newer files are skipped with a warning; a PATH that is unusable is an error (exit 1). The
 // fields load on any number of ranks (PETSc's HDF5 viewer reads each rank's hyperslab).
 #pragma once

@@ -1,10 +1,9 @@
 #include "app/run_loop.hpp"
 
+#include "app/reaction_stiffness.hpp"
 #include "core/collective_error.hpp"
 #include "core/log_events.hpp"
 #include "core/user_error.hpp"
-#include "io/png_file.hpp"
-#include "io/slice_gather.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,36 +11,8 @@
 
 namespace morphogen {
 
-void write_pngs(Simulation& sim, const std::string& tag) {
-  const Grid& g = sim.grid();
-  const PetscInt k = g.dim() == 3 ? g.spec().n[2] / 2 : 0;
-  int rank = 0;
-  MPI_Comm_rank(g.comm(), &rank);
-  std::string err;
-  LogScope log_scope(log_events().output);
-  for (int s : sim.output().png_species) {
-    const PetscScalar* a;
-    MG_PETSC(VecGetArrayRead(sim.state()[s], &a));
-    std::vector<double> slice = io::gather_xy_slice(g, a, k);
-    MG_PETSC(VecRestoreArrayRead(sim.state()[s], &a));
-    if (rank != 0 || !err.empty()) continue;
-    double lo = sim.output().png_range[s][0], hi = sim.output().png_range[s][1];
-    if (!(lo < hi)) {
-      lo = *std::min_element(slice.begin(), slice.end());
-      hi = *std::max_element(slice.begin(), slice.end());
-    }
-    const std::string path = sim.output().dir + "/" + sim.species()[s] + "_" + tag + ".png";
-    try {
-      io::write_field_png(path, static_cast<int>(g.spec().n[0]), static_cast<int>(g.spec().n[1]),
-                          slice.data(), lo, hi);
-    } catch (const UserError& e) {
-      err = std::string("-output_dir ") + sim.output().dir + ": " + e.what();
-    }
-  }
-  throw_if_any(g.comm(), err);
-}
-
-bool run_loop(Simulation& sim, PetscInt end_step, RunOutput& output, bool final_level) {
+bool run_loop(Simulation& sim, PetscInt end_step, RunOutput& output, PngOutput& pngs,
+              bool final_level) {
   MPI_Comm comm = sim.grid().comm();
   const PetscInt first = sim.step_index();
   const PetscInt steps = end_step - first;
@@ -51,15 +22,18 @@ bool run_loop(Simulation& sim, PetscInt end_step, RunOutput& output, bool final_
   const double t0 = MPI_Wtime();
   double t_last = t0;
   PetscInt step_last = 0;
-  auto check_finite = [&] {
+  auto check_finite = [&] { output.check_finite(sim); };
+  // Images are this run's output too: the first one commits the directory (RunOutput::commit);
+  // a failed write stops every rank with exit code 4.
+  auto write_images = [&](const std::string& image_tag) {
+    output.commit();
     try {
-      sim.check_finite();
+      pngs.write(sim, image_tag);
     } catch (const UserError& e) {
-      throw UserError(std::string(e.what()) + "; last good checkpoint: " +
-                      (output.last_checkpoint().empty() ? "none written by this run"
-                                                        : output.last_checkpoint()));
+      output.images_failed(e.what());
     }
   };
+  if (sim.level() == 0) warn_if_reaction_stiff(sim);
   for (PetscInt n = 1; n <= steps; ++n) {
     sim.step();
     if (n % out.nan_check_every == 0 || n == steps) check_finite();
@@ -73,7 +47,7 @@ bool run_loop(Simulation& sim, PetscInt end_step, RunOutput& output, bool final_
     }
     if (out.png_every > 0 && sim.step_index() % out.png_every == 0 && n != steps) {
       std::snprintf(tag, sizeof tag, "%07lld", static_cast<long long>(sim.step_index()));
-      write_pngs(sim, tag);
+      write_images(tag);
     }
     if (n % out.progress_every == 0 || n == steps) {
       const double now = MPI_Wtime();
@@ -94,8 +68,8 @@ bool run_loop(Simulation& sim, PetscInt end_step, RunOutput& output, bool final_
   if (final_level) {
     check_finite();
     std::snprintf(tag, sizeof tag, "%07lld", static_cast<long long>(sim.step_index()));
-    write_pngs(sim, tag);
-    write_pngs(sim, "final");
+    write_images(tag);
+    write_images("final");
     output.finish(sim);
   }
   return false;

@@ -4,17 +4,17 @@
 // steps and at the end.
 #pragma once
 
+#include "app/png_output.hpp"
 #include "app/run_output.hpp"
 #include "app/simulation.hpp"
 
 namespace morphogen {
 
-// Writes PNG images of the selected species at the current step into the output directory.
-void write_pngs(Simulation& sim, const std::string& tag);
-
 // Steps until sim.step_index() == end_step. Returns false when it got there, true when it
 // stopped early with a checkpoint (signal or wall-time budget; see output.stop_reason()).
-// final_level: write the final images, snapshot and checkpoint at the end.
-bool run_loop(Simulation& sim, PetscInt end_step, RunOutput& output, bool final_level);
+// final_level: write the final images, snapshot and checkpoint at the end. pngs writes the
+// PNG quick-looks (every -png_every steps and at the end).
+bool run_loop(Simulation& sim, PetscInt end_step, RunOutput& output, PngOutput& pngs,
+              bool final_level);
 
 } // namespace morphogen

@@ -1,6 +1,9 @@
 #include "app/run_main.hpp"
 
 #include "app/deck.hpp"
+#include "app/help.hpp"
+#include "app/path_check.hpp"
+#include "app/png_output.hpp"
 #include "app/restart.hpp"
 #include "app/run_loop.hpp"
 #include "app/simulation.hpp"
@@ -17,42 +20,6 @@ namespace morphogen {
 
 namespace {
 
-void print_models(MPI_Comm comm) {
-  PetscPrintf(comm, "\nModels (-model NAME):\n");
-  for (const auto& m : model_registry()) {
-    PetscPrintf(comm, "  %-18s %s (%s)\n", m.name, m.doc, m.reference);
-    for (int s = 0; s < m.nspecies; ++s)
-      PetscPrintf(comm, "      species %-6s D %-10s init %-10s %s\n", m.species[s].name,
-                  format_double(m.species[s].D).c_str(), format_double(m.species[s].init).c_str(),
-                  m.species[s].doc);
-    for (int q = 0; q < m.nparams; ++q)
-      PetscPrintf(comm, "      param   %-6s default %-10s range [%s, %s]  %s\n", m.params[q].name,
-                  format_double(m.params[q].def).c_str(), format_double(m.params[q].lo).c_str(),
-                  format_double(m.params[q].hi).c_str(), m.params[q].doc);
-  }
-}
-
-void prepare_output(MPI_Comm comm, const Options& opt, const Simulation& sim) {
-  int rank = 0;
-  MPI_Comm_rank(comm, &rank);
-  std::string err;
-  if (rank == 0) {
-    std::error_code ec;
-    std::filesystem::create_directories(sim.output().dir, ec);
-    if (ec) {
-      err = "-output_dir " + sim.output().dir + ": cannot create directory (" + ec.message() + ")";
-    } else {
-      const std::string path = sim.output().dir + "/options_used.yaml";
-      std::ofstream f(path);
-      f << opt.to_yaml("# Options of this run, resolved (morphogen " MORPHOGEN_VERSION
-                       "). Rerun with: morphogen " +
-                       path + "\n");
-      if (!f) err = "-output_dir " + sim.output().dir + ": cannot write " + path;
-    }
-  }
-  throw_if_any(comm, err);
-}
-
 void print_header(MPI_Comm comm, const Simulation& sim, int level, int levels) {
   int size = 1;
   MPI_Comm_size(comm, &size);
@@ -66,21 +33,20 @@ void print_header(MPI_Comm comm, const Simulation& sim, int level, int levels) {
   for (int d = 1; d < g.dim; ++d)
     PetscPrintf(comm, ",%s", boundary_name(g.bc[d]));
   PetscPrintf(comm, "), %s stencil, dt %s (explicit bound %s), %lld steps, %d rank%s -> %s/\n",
-              sim.stencil().name.c_str(), format_double(sim.dt()).c_str(),
-              format_double(sim.stable_dt()).c_str(), static_cast<long long>(sim.steps()), size,
+              sim.stencil().name.c_str(), format_number(sim.dt()).c_str(),
+              format_number(sim.stable_dt()).c_str(), static_cast<long long>(sim.steps()), size,
               size == 1 ? "" : "s", sim.output().dir.c_str());
 }
 
 } // namespace
 
-int run_main(int* argc, char*** argv, double wall_start) {
+int run_main(int* argc, char*** argv, double wall_start,
+             const std::vector<OptionsFileArg>& options_files) {
   MPI_Comm comm = PETSC_COMM_WORLD;
-  const std::string base_dir = load_deck(argc, argv);
+  const std::string base_dir = load_deck(argc, argv, options_files);
   Options opt(comm);
   if (opt.is_set("sweep_axes"))
     throw UserError("-sweep_axes: this deck is a sweep; run it with morphogen sweep DECK.yaml");
-  if (opt.help_requested())
-    PetscPrintf(comm, "morphogen %s options (-name <current value>: help):\n", MORPHOGEN_VERSION);
   // Coarse-to-fine grid sequencing (Witkin-Kass 5.2, Lawlor): levels 1..L-1 run on grids
   // coarsened by 2^(L-1-l) for -sequence_steps steps each, the last on -grid_n for -steps.
   const int levels = static_cast<int>(
@@ -101,11 +67,18 @@ int run_main(int* argc, char*** argv, double wall_start) {
                  "restart from a checkpoint file, or 'latest': the newest complete checkpoint in "
                  "-output_dir (none there: start from the initial condition)");
   auto first = std::make_unique<Simulation>(comm, opt, base_dir, SequenceLevel{0, levels, nullptr});
+  PngOutput pngs(opt, *first);
   if (opt.help_requested()) {
-    print_models(comm);
+    print_options_help(comm, {&opt});
+    print_models_help(comm);
     return 0;
   }
+  const std::string model = first->model().name;
+  opt.set_unknown_hint([model](const std::string& name) { return other_model_hint(name, model); });
   opt.check_unused();
+  // A directory name that cannot be created whole fails before any parent is created.
+  if (const std::string bad = directory_name_problem(first->output().dir); !bad.empty())
+    throw UserError("-output_dir " + first->output().dir.substr(0, 40) + "...: " + bad);
   std::optional<RestartPoint> rp;
   if (!restart.empty()) rp = locate_restart(comm, restart, first->output().dir, first->model());
   const int start = rp ? rp->level : 0;
@@ -123,8 +96,8 @@ int run_main(int* argc, char*** argv, double wall_start) {
                       std::to_string(end_at_start) + "); raise -steps");
     if (start == 0) check_restart_grid(*first, *rp);
   }
-  prepare_output(comm, opt, *first);
   RunOutput output(comm, opt, wall_start);
+  output.prepare(*first); // options_used.yaml is replaced when the run writes its first file
   std::unique_ptr<Simulation> prev;
   PetscInt end = 0; // global step index at which the current level ends
   for (int l = 0; l < levels; ++l) {
@@ -146,13 +119,14 @@ int run_main(int* argc, char*** argv, double wall_start) {
                         std::to_string(rp->step) + ", past the end of the run (step " +
                         std::to_string(end) + "); raise -steps");
       restore(*sim, *rp);
-      PetscPrintf(comm, "restart from %s: step %lld, t %.6g (written on %lld rank%s)\n",
-                  rp->path.c_str(), rp->step, rp->time, *rp->info.attributes.integer("nranks"),
-                  *rp->info.attributes.integer("nranks") == 1 ? "" : "s");
+      const long long* nranks = rp->info.attributes.integer("nranks");
+      PetscPrintf(comm, "restart from %s: step %lld, t %s (written on %lld rank%s)\n",
+                  rp->path.c_str(), rp->step, format_number(rp->time).c_str(),
+                  nranks ? *nranks : 0LL, nranks && *nranks == 1 ? "" : "s");
     }
     output.begin(*sim, restarting ? rp->step : (l == 0 ? -1 : sim->step_index()), end);
     print_header(comm, *sim, l, levels);
-    if (run_loop(*sim, end, output, l + 1 == levels)) return kExitResubmit;
+    if (run_loop(*sim, end, output, pngs, l + 1 == levels)) return kExitResubmit;
     prev = std::move(sim);
   }
   const std::string& dir = prev->output().dir;

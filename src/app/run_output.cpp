@@ -3,6 +3,7 @@
 #include "core/collective_error.hpp"
 #include "core/log_events.hpp"
 #include "core/stop_signal.hpp"
+#include "core/user_error.hpp"
 #include "io/checkpoint_files.hpp"
 
 #include <hdf5.h>
@@ -10,9 +11,12 @@
 #include <csignal>
 #include <sys/statvfs.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <unistd.h>
 
 namespace morphogen {
 
@@ -51,9 +55,81 @@ RunOutput::RunOutput(MPI_Comm comm, const Options& opt, double wall_start)
   MPI_Comm_size(comm, &size_);
 }
 
+RunOutput::~RunOutput() {
+  if (committed_ || options_tmp_.empty()) return;
+  std::error_code ec;
+  std::filesystem::remove(options_tmp_, ec);
+}
+
+void RunOutput::prepare(const Simulation& sim) {
+  const std::string& dir = sim.output().dir;
+  dir_ = dir;
+  std::string err;
+  if (rank_ == 0) {
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec) err = "-output_dir " + dir + ": cannot create directory (" + ec.message() + ")";
+  }
+  throw_if_any(comm_, err);
+  if (rank_ != 0) return;
+  const std::string path = dir + "/options_used.yaml";
+  const std::string text = opt_.to_yaml("# Options of this run, resolved (morphogen " MORPHOGEN_VERSION
+                                        "). Rerun with: morphogen " +
+                                        path + "\n");
+  options_tmp_ = path + ".tmp";
+  std::FILE* f = std::fopen(options_tmp_.c_str(), "w");
+  const bool ok = f && std::fwrite(text.data(), 1, text.size(), f) == text.size() &&
+                  std::fflush(f) == 0 && fsync(fileno(f)) == 0;
+  const int errnum = errno;
+  if (f) std::fclose(f);
+  if (!ok) {
+    std::error_code rm;
+    std::filesystem::remove(options_tmp_, rm);
+    options_tmp_.clear();
+    write_failed("options", path, std::strerror(errnum));
+  }
+}
+
+void RunOutput::commit() {
+  if (committed_) return;
+  committed_ = true;
+  if (rank_ != 0) return;
+  if (!options_tmp_.empty()) {
+    const std::string path = options_tmp_.substr(0, options_tmp_.size() - 4);
+    std::error_code ec;
+    std::filesystem::rename(options_tmp_, path, ec);
+    if (ec) write_failed("options", path, "rename: " + ec.message());
+  }
+  if (retire_pending_) {
+    retire_pending_ = false;
+    for (const auto& p : io::retire_checkpoints_after(dir_, retire_after_))
+      std::printf("note: %s is %s: renamed to %s.stale*\n", p.c_str(),
+                  retire_after_ < 0 ? "from an earlier run" : "newer than the restart point",
+                  p.c_str());
+    std::fflush(stdout);
+  }
+}
+
+void RunOutput::check_finite(const Simulation& sim) const {
+  try {
+    sim.check_finite();
+  } catch (const UserError& e) {
+    throw UserError(std::string(e.what()) + "; last good checkpoint: " +
+                    (last_checkpoint_.empty() ? "none written by this run" : last_checkpoint_));
+  }
+}
+
+void RunOutput::images_failed(const std::string& err) const {
+  if (rank_ == 0) write_failed("images into", dir_ + "/", err);
+  MPI_Barrier(comm_); // rank 0 aborts the job
+  MPI_Abort(comm_, kExitWriteFailed);
+  std::abort();
+}
+
 void RunOutput::begin(Simulation& sim, long long restart_step, PetscInt end_step) {
   const auto& out = sim.output();
   grid_ = &sim.grid();
+  dir_ = out.dir;
   io_ = std::make_unique<io::VtkHdfIO>(sim.grid());
   if (!series_) {
     series_ = std::make_unique<io::SeriesIndex>(out.dir, out.name);
@@ -68,12 +144,16 @@ void RunOutput::begin(Simulation& sim, long long restart_step, PetscInt end_step
           std::filesystem::remove(it->path(), rm);
         }
       }
-      const auto retired = io::retire_checkpoints_after(out.dir, restart_step);
-      for (const auto& p : retired)
-        std::printf("note: %s is %s: renamed to %s.stale*\n", p.c_str(),
-                    restart_step < 0 ? "from an earlier run" : "newer than the restart point",
-                    p.c_str());
-      if (restart_step >= 0) series_->load_existing(restart_step);
+      // Checkpoints of an earlier run (or newer than the restart point) are retired when this
+      // run writes its first file (commit()), not before: a run that fails first leaves them.
+      retire_pending_ = true;
+      retire_after_ = restart_step;
+      if (restart_step >= 0) {
+        series_->load_existing(restart_step);
+        const std::string from = out.dir + "/" + io::checkpoint_file_name(restart_step);
+        std::error_code ec;
+        if (std::filesystem::is_regular_file(from, ec)) last_checkpoint_ = from;
+      }
       std::fflush(stdout);
     }
   }
@@ -97,6 +177,8 @@ int RunOutput::poll_stop_flags(const Simulation& sim) {
   const double now = MPI_Wtime();
   const double step = now - last_step_wall_;
   last_step_wall_ = now;
+  loop_seconds_ += step;
+  cell_updates_ += static_cast<double>(sim.grid().global_cells());
   step_seconds_ = step_seconds_ == 0 ? step : 0.9 * step_seconds_ + 0.1 * step;
   int flags = 0;
   const int sig = stop_signal_received();
@@ -165,11 +247,14 @@ void RunOutput::finish(Simulation& sim) {
   }
   nlohmann::json stability = stability_record(sim);
   if (rank_ != 0) return;
-  nlohmann::json j = {{"model", sim.model().name},
-                      {"step", static_cast<long long>(sim.step_index())},
-                      {"time", sim.time()},
-                      {"species", species},
-                      {"stability", stability}};
+  nlohmann::json j = {
+      {"model", sim.model().name},
+      {"step", static_cast<long long>(sim.step_index())},
+      {"time", sim.time()},
+      {"species", species},
+      {"stability", stability},
+      {"run", run_record(MPI_Wtime() - wall_start_, cell_updates_, loop_seconds_, size_)}};
+  commit();
   const std::string path = sim.output().dir + "/summary.json";
   const std::string err = io::write_file_atomically(
       path, j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
@@ -184,6 +269,7 @@ void RunOutput::finish(Simulation& sim) {
 void RunOutput::write_snapshot(Simulation& sim) {
   const long long n = sim.step_index();
   if (n == last_snapshot_step_) return;
+  commit();
   LogScope log_scope(log_events().output);
   const auto& out = sim.output();
   const std::string file = step_file(out.name, n);
@@ -216,7 +302,8 @@ void RunOutput::write_snapshot(Simulation& sim) {
 void RunOutput::write_checkpoint(Simulation& sim) {
   const long long n = sim.step_index();
   if (n == last_checkpoint_step_) return;
-  sim.check_finite(); // never checkpoint a diverged state as "good"
+  check_finite(sim); // never checkpoint a diverged state as "good"
+  commit();
   LogScope log_scope(log_events().output);
   const double t0 = MPI_Wtime();
   const auto& out = sim.output();

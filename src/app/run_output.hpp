@@ -26,10 +26,33 @@ class RunOutput {
 public:
   // wall_start: MPI_Wtime() when the program started (for -max_walltime).
   RunOutput(MPI_Comm comm, const Options& opt, double wall_start);
+  // Removes options_used.yaml.tmp if the run ended before writing anything (see prepare).
+  ~RunOutput();
+  RunOutput(const RunOutput&) = delete;
+  RunOutput& operator=(const RunOutput&) = delete;
+
+  // Before the run: creates -output_dir (failure: UserError, exit 1) and writes the resolved
+  // options to options_used.yaml.tmp (failure, e.g. a read-only or full directory: exit 4,
+  // nothing touched). The existing output (options_used.yaml, checkpoints) stays as it is
+  // until commit().
+  void prepare(const Simulation& sim);
+  // Before the first file of this run is written (called by every writer, and by run_loop
+  // before images): renames options_used.yaml.tmp to options_used.yaml and retires the
+  // checkpoints of an earlier run (or, after a restart, those newer than its step), so that
+  // input rejected during the run (an expression that fails at a later t) leaves the
+  // directory untouched. Rank 0 acts; call on every rank.
+  void commit();
+  // Collective NaN/Inf/blow-up guard (Simulation::check_finite) whose message names the last
+  // good checkpoint (of this run, or the one it restarted from).
+  void check_finite(const Simulation& sim) const;
+  // Collective: an image (or other output) of this run could not be written: one line naming
+  // it and the last good checkpoint, and every rank stops with exit code 4.
+  [[noreturn]] void images_failed(const std::string& err) const;
 
   // Start writing for a (new level's) simulation. restart_step < 0: a fresh run (checkpoints
-  // of an earlier run in the directory are retired, the series starts empty); otherwise the run
-  // continues from that step (later checkpoints are retired, later series entries dropped).
+  // of an earlier run in the directory are retired at commit(), the series starts empty);
+  // otherwise the run continues from that step (later checkpoints are retired at commit(),
+  // later series entries dropped).
   void begin(Simulation& sim, long long restart_step, PetscInt end_step);
   // After every step. Returns true when the run must stop (a checkpoint has been written).
   bool after_step(Simulation& sim);
@@ -56,9 +79,15 @@ private:
   const Grid* grid_ = nullptr;
   double wall_start_ = 0, next_wall_checkpoint_ = 0, last_write_seconds_ = 0;
   double step_seconds_ = 0, last_step_wall_ = 0;
+  double loop_seconds_ = 0, cell_updates_ = 0; // time loop totals, for summary.json "run"
   double next_snapshot_time_ = 0, next_checkpoint_time_ = 0;
   long long last_snapshot_step_ = -1, last_checkpoint_step_ = -1;
   std::string last_checkpoint_, stop_reason_;
+  std::string dir_;                // -output_dir
+  std::string options_tmp_;        // options_used.yaml.tmp until commit() (rank 0)
+  bool committed_ = false;         // commit() has run
+  bool retire_pending_ = false;    // checkpoints to retire at commit()
+  long long retire_after_ = -1;    // retire those with a step > this (-1: all)
   FieldSampler sampler_;
   PetscInt sample_every_ = 0;
 };

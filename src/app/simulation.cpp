@@ -205,7 +205,6 @@ void Simulation::read_model(Options& opt, const std::string& base_dir) {
     any_dirichlet |= spec_.bc[d] == Boundary::Dirichlet;
   dirichlet_.assign(any_dirichlet ? ns : 0, FaceValues{});
   u_.clear();
-  work_.clear();
   ops_.clear();
   for (int s = 0; s < ns; ++s) {
     const SpeciesInfo& si = model_->species[s];
@@ -224,7 +223,6 @@ void Simulation::read_model(Options& opt, const std::string& base_dir) {
                                   ": number, expression, 'v +- a%', shapes, png(...)"),
                    spec_, seed_, base_dir);
     u_.push_back(grid_->create_local());
-    work_.push_back(grid_->create_local());
     PetscScalar* a;
     MG_PETSC(VecGetArray(u_.back(), &a));
     try {
@@ -296,6 +294,13 @@ void Simulation::read_time(Options& opt) {
                  "every -ts_ option)");
   split_ = kind == "split";
   ts_ = kind == "ts";
+  ts_implicit_diffusion_ =
+      opt.choice("ts_diffusion", "implicit", {"implicit", "explicit"},
+                 "with -integrator ts: diffusion in the implicit part (IMEX, default) or with "
+                 "every other term in the explicit right-hand side (explicit TS types: rk, "
+                 "euler, ssp)") == "implicit";
+  if (!ts_ && opt.is_set("ts_diffusion"))
+    throw UserError("-ts_diffusion: applies to -integrator ts only");
   // With grid sequencing every level uses the finest level's dt and stability bound (the
   // bound scales with h^2), so a bad -dt fails before the first level writes anything.
   const bool constant = all_constant_diffusion();
@@ -305,7 +310,7 @@ void Simulation::read_time(Options& opt) {
   const double def_dt = std::isfinite(stable_dt_) ? 0.9 * stable_dt_ : 1.0;
   dt_ = opt.real("dt", def_dt, 0.0, kMaxReal, "time step");
   if (!(dt_ > 0)) throw UserError("-dt " + format_double(dt_) + ": must be > 0");
-  if (!split_ && !ts_) {
+  if (!split_ && !(ts_ && ts_implicit_diffusion_)) {
     const bool force = opt.flag("force_dt", false,
                                 "run even when -dt exceeds the explicit diffusion stability bound");
     double lmax = 0;
@@ -331,54 +336,77 @@ void Simulation::read_time(Options& opt) {
   steps_ =
       opt.integer("steps", 1000, 0, std::numeric_limits<PetscInt>::max(), "number of time steps");
   sources_ = std::make_unique<SourceTerms>(*grid_, opt, species_, seed_, base_dir_);
-  if (ts_) {
-    // The step loop sets TS's time, final time and step from -dt: refuse the TS spellings.
-    for (const char* k : {"ts_dt", "ts_max_time", "ts_init_time", "ts_max_steps"})
-      if (opt.is_set(k))
-        throw UserError(std::string("-") + k +
-                        ": set by morphogen with -integrator ts; use -dt (the step, or the "
-                        "output interval with -ts_adapt_type basic) and -steps");
-    for (const char* k :
-         {"ts_type", "ts_arkimex_type", "ts_adapt_type", "ts_rtol", "ts_atol", "ts_monitor",
-          "snes_type", "ksp_type", "pc_type", "sub_pc_type", "ksp_rtol"})
-      opt.known(k);
+  build_terms();
+  stepper_ = integrator_.get();
+  if (ts_) read_ts(opt);
+  if (split_) read_split(opt);
+}
+
+// The run's terms: diffusion per species, the reaction, sources, and the clamp floor.
+void Simulation::build_terms() {
+  for (size_t s = 0; s < ops_.size(); ++s)
+    terms_.add(std::make_unique<DiffusionTerm>(static_cast<int>(s), species_[s], *ops_[s]));
+  terms_.add(std::make_unique<ReactionTerm>(*grid_, model_->name, model_->rates, model_->nspecies,
+                                            params_));
+  if (sources_->any()) terms_.add(std::make_unique<SourceTerm>(*grid_, *sources_, species_));
+  bool clamp = false;
+  for (double f : floor_)
+    clamp = clamp || std::isfinite(f);
+  if (clamp) terms_.add(std::make_unique<ClampFloor>(*grid_, floor_));
+  integrator_->use_terms(terms_);
+}
+
+void Simulation::read_ts(Options& opt) {
+  // The step loop sets TS's time, final time and step from -dt: refuse the TS spellings.
+  for (const char* k : {"ts_dt", "ts_max_time", "ts_init_time", "ts_max_steps"})
+    if (opt.is_set(k))
+      throw UserError(std::string("-") + k +
+                      ": set by morphogen with -integrator ts; use -dt (the step, or the "
+                      "output interval with -ts_adapt_type basic) and -steps");
+  for (const char* k :
+       {"ts_type", "ts_arkimex_type", "ts_rk_type", "ts_adapt_type", "ts_rtol", "ts_atol",
+        "ts_monitor", "snes_type", "ksp_type", "pc_type", "sub_pc_type", "ksp_rtol"})
+    opt.known(k);
+  const bool implicit = ts_implicit_diffusion_;
+  if (implicit)
     matrices_ = std::make_unique<OperatorMatrices>(*grid_, *halo_, stencil_, operators(),
                                                    dirichlet_.empty() ? nullptr : &dirichlet_);
-    ts_integrator_ = std::make_unique<TsIntegrator>(*grid_, model_->rates, species_, params_,
-                                                    floor_, *matrices_, sources_.get(), dt_);
-  }
-  if (split_) {
-    SplitSettings set;
-    const std::string ord = opt.choice("split_ordering", "strang", {"lie", "strang"},
-                                       "splitting: lie (first order) or strang (second order)");
-    set.ordering = ord == "lie" ? SplitOrdering::Lie : SplitOrdering::Strang;
-    const bool strang = set.ordering == SplitOrdering::Strang;
-    const std::string rs =
-        opt.choice("split_reaction", strang ? "trapezoidal" : "backward_euler",
-                   {"euler", "heun", "backward_euler", "trapezoidal"},
-                   "reaction substep: euler, heun (explicit), backward_euler, trapezoidal "
-                   "(implicit per cell, Newton with the analytic Jacobian)");
-    set.reaction = rs == "euler"            ? ReactionScheme::Euler
-                   : rs == "heun"           ? ReactionScheme::Heun
-                   : rs == "backward_euler" ? ReactionScheme::BackwardEuler
-                                            : ReactionScheme::Trapezoidal;
-    const std::string ds =
-        opt.choice("split_diffusion", strang ? "crank_nicolson" : "backward_euler",
-                   {"backward_euler", "crank_nicolson"},
-                   "diffusion substep: backward_euler or crank_nicolson");
-    set.theta = ds == "backward_euler" ? 1.0 : 0.5;
-    set.newton_tol = opt.real("split_newton_tol", 1e-12, 1e-16, 1e-2,
-                              "relative tolerance of the per-cell Newton solve");
-    set.newton_max_it = static_cast<int>(
-        opt.integer("split_newton_max_it", 20, 1, 1000, "Newton iteration cap per cell"));
-    matrices_ = std::make_unique<OperatorMatrices>(*grid_, *halo_, stencil_, operators(),
-                                                   dirichlet_.empty() ? nullptr : &dirichlet_);
-    diffusion_ = std::make_unique<DiffusionSolver>(*grid_, *matrices_, species_, opt);
-    diffusion_->prepare(dt_, set.theta);
-    split_integrator_ = std::make_unique<SplitIntegrator>(
-        *grid_, model_->kernels.reaction_row[params_.any_field() ? 1 : 0], species_, params_,
-        floor_, sources_.get(), *diffusion_, set);
-  }
+  ts_integrator_ = std::make_unique<TsIntegrator>(*grid_, *halo_, species_, terms_, matrices_.get(),
+                                                  dirichlet_.empty() ? nullptr : &dirichlet_, dt_);
+  stepper_ = ts_integrator_.get();
+}
+
+void Simulation::read_split(Options& opt) {
+  SplitSettings set;
+  const std::string ord = opt.choice("split_ordering", "strang", {"lie", "strang"},
+                                     "splitting: lie (first order) or strang (second order)");
+  set.ordering = ord == "lie" ? SplitOrdering::Lie : SplitOrdering::Strang;
+  const bool strang = set.ordering == SplitOrdering::Strang;
+  const std::string rs =
+      opt.choice("split_reaction", strang ? "trapezoidal" : "backward_euler",
+                 {"euler", "heun", "backward_euler", "trapezoidal"},
+                 "reaction substep: euler, heun (explicit), backward_euler, trapezoidal "
+                 "(implicit per cell, Newton with the analytic Jacobian)");
+  set.reaction = rs == "euler"            ? ReactionScheme::Euler
+                 : rs == "heun"           ? ReactionScheme::Heun
+                 : rs == "backward_euler" ? ReactionScheme::BackwardEuler
+                                          : ReactionScheme::Trapezoidal;
+  const std::string ds = opt.choice("split_diffusion", strang ? "crank_nicolson" : "backward_euler",
+                                    {"backward_euler", "crank_nicolson"},
+                                    "diffusion substep: backward_euler or crank_nicolson");
+  set.theta = ds == "backward_euler" ? 1.0 : 0.5;
+  set.newton_tol = opt.real("split_newton_tol", 1e-12, 1e-16, 1e-2,
+                            "relative tolerance of the per-cell Newton solve");
+  set.newton_max_it = static_cast<int>(
+      opt.integer("split_newton_max_it", 20, 1, 1000, "Newton iteration cap per cell"));
+  matrices_ = std::make_unique<OperatorMatrices>(*grid_, *halo_, stencil_, operators(),
+                                                 dirichlet_.empty() ? nullptr : &dirichlet_);
+  diffusion_ = std::make_unique<DiffusionSolver>(*grid_, *matrices_, species_, opt);
+  diffusion_->prepare(dt_, set.theta);
+  split_integrator_ = std::make_unique<SplitIntegrator>(
+      *grid_, model_->kernels.reaction_row[params_.any_field() ? 1 : 0], species_, params_, floor_,
+      sources_.get(), *diffusion_, set);
+  stepper_ = split_integrator_.get();
 }
 
 void Simulation::read_output(Options& opt) {
@@ -461,14 +489,7 @@ void Simulation::read_snapshot_options(Options& opt) {
 }
 
 void Simulation::step() {
-  if (split_) {
-    split_integrator_->step(u_, t_, dt_, step_ + 1);
-  } else if (ts_) {
-    ts_integrator_->step(u_, t_, dt_, step_ + 1);
-  } else {
-    integrator_->step(u_, work_, dt_);
-    if (sources_->any()) add_sources(t_);
-  }
+  stepper_->step(u_, t_, dt_, step_ + 1);
   t_ += dt_;
   ++step_;
 }
@@ -486,25 +507,10 @@ bool Simulation::all_constant_diffusion() const {
   return true;
 }
 
-void Simulation::add_sources(double t) {
-  // Forward Euler of the source: u += dt S(t), then the clamp floor.
-  const Box& ob = grid_->owned();
-  for (size_t s = 0; s < u_.size(); ++s) {
-    const double* S = sources_->at(static_cast<int>(s), t);
-    if (!S) continue;
-    PetscScalar* a;
-    MG_PETSC(VecGetArray(u_[s], &a));
-    for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
-      for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j)
-        for (PetscInt i = ob.s[0]; i < ob.s[0] + ob.m[0]; ++i) {
-          double& v = a[grid_->local_index(i, j, k)];
-          v = std::max(v + dt_ * S[grid_->owned_index(i, j, k)], floor_[s]);
-        }
-    MG_PETSC(VecRestoreArray(u_[s], &a));
-  }
-}
-
 void Simulation::check_finite() const {
+  // A run that blows up may stay finite for a long time (a checkerboard growing to 1e69):
+  // values beyond the classifier's blow-up bound (analysis::kBlowupBound) count as diverged.
+  constexpr double kBlowup = 1e10;
   std::string err;
   const Box& ob = grid_->owned();
   for (size_t s = 0; s < u_.size() && err.empty(); ++s) {
@@ -514,8 +520,9 @@ void Simulation::check_finite() const {
       for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1] && err.empty(); ++j)
         for (PetscInt i = ob.s[0]; i < ob.s[0] + ob.m[0]; ++i) {
           const double v = a[grid_->local_index(i, j, k)];
-          if (!std::isfinite(v)) {
-            err = "species " + species_[s] + " became " + format_double(v) + " at cell (" +
+          if (!(std::fabs(v) <= kBlowup)) { // NaN, Inf or blown up
+            err = "species " + species_[s] + " became " + format_double(v) +
+                  (std::isfinite(v) ? " (over the blow-up bound 1e10)" : "") + " at cell (" +
                   std::to_string(i) + "," + std::to_string(j) + "," + std::to_string(k) +
                   ") by step " + std::to_string(step_) + " (t = " + format_double(t_) +
                   "): the run diverged; reduce -dt" +

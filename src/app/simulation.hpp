@@ -12,6 +12,8 @@
 #include "integrators/explicit_integrator.hpp"
 #include "integrators/split_integrator.hpp"
 #include "integrators/ts_integrator.hpp"
+#include "operators/pointwise_terms.hpp"
+#include "operators/term_list.hpp"
 
 #include <memory>
 #include <string>
@@ -85,6 +87,8 @@ public:
 
   // Advance one step with the configured integrator.
   void step();
+  // The run's terms and constraints (what the integrators consume).
+  const TermList& terms() const { return terms_; }
   bool split() const { return split_; }
   const DiffusionSolver* diffusion_solver() const { return diffusion_.get(); }
   const SplitIntegrator* split_integrator() const { return split_integrator_.get(); }
@@ -102,7 +106,9 @@ private:
   void read_time(Options& opt);
   void read_output(Options& opt);
   void read_snapshot_options(Options& opt);
-  void add_sources(double t);
+  void build_terms();
+  void read_ts(Options& opt);
+  void read_split(Options& opt);
 
   MPI_Comm comm_;
   std::string base_dir_;
@@ -115,16 +121,18 @@ private:
   std::vector<double> D_, floor_;
   ParamSet params_;
   std::vector<FaceValues> dirichlet_;
-  std::vector<VecH> u_, work_;
+  std::vector<VecH> u_;
   std::vector<bool> tensor_; // per species: -diffusion_S tensor
   std::vector<std::unique_ptr<DiffusionOperator>> ops_;
   std::unique_ptr<OperatorMatrices> matrices_; // split and TS; before the integrators using it
-  std::unique_ptr<ExplicitIntegrator> integrator_;
   std::unique_ptr<SourceTerms> sources_;
+  TermList terms_; // after the operators, parameters and sources its terms refer to
+  std::unique_ptr<ExplicitIntegrator> integrator_;
   std::unique_ptr<DiffusionSolver> diffusion_;
   std::unique_ptr<SplitIntegrator> split_integrator_;
   std::unique_ptr<TsIntegrator> ts_integrator_;
-  bool split_ = false, ts_ = false;
+  Integrator* stepper_ = nullptr; // the integrator step() uses
+  bool split_ = false, ts_ = false, ts_implicit_diffusion_ = true;
   PetscInt level_factor_ = 1; // coarsening factor of this sequencing level (1: finest)
   int level_index_ = 0;
   std::uint64_t seed_ = 1;

@@ -2,14 +2,18 @@
 //
 //   morphogen [DECK.yaml] [-option value ...]           (one run, app/run_main.hpp)
 //   morphogen sweep DECK.yaml [-option value ...]     (phase-diagram sweep, sweep/sweep_main.hpp)
+//   morphogen -help | -help petsc | --version         (app/command_line.hpp)
 //
 // The entry point: the top layer, above app and sweep (which sits on app), so neither of them
 // needs to know about the other. Exit codes: 0 success, 1 bad input or a diverged run (one-line
 // message), 2 an internal PETSc error (PETSc prints its trace), 3 stopped by SIGUSR1/SIGTERM or
 // -max_walltime after writing a checkpoint (resubmit with -restart latest), 4 an output file
 // could not be written.
+#include "app/command_line.hpp"
 #include "app/run_main.hpp"
+#include "cli/exit_file.hpp"
 #include "core/collective_error.hpp"
+#include "core/options.hpp"
 #include "core/petsc_handle.hpp"
 #include "core/stop_signal.hpp"
 #include "core/user_error.hpp"
@@ -22,14 +26,23 @@
 using namespace morphogen;
 
 int main(int argc, char** argv) {
+  // -h/--help/-help, --version/-version and -options_file are ours (app/command_line.hpp).
+  const CommandLine cl = take_command_line(&argc, argv);
   PetscCall(PetscInitialize(&argc, &argv, nullptr,
                             "morphogen [DECK.yaml] [-option value ...]; -help lists options\n"));
   install_stop_signal_handlers();
   const double wall_start = MPI_Wtime(); // -max_walltime counts from here
   int rc = 0;
   try {
-    rc = argc > 1 && std::string(argv[1]) == "sweep" ? sweep::run_sweep(&argc, &argv)
-                                                     : run_main(&argc, &argv, wall_start);
+    if (!cl.error.empty()) throw UserError(cl.error);
+    if (cl.version) {
+      print_version(PETSC_COMM_WORLD);
+    } else {
+      if (cl.help != CommandLine::Help::None) Options::request_help();
+      rc = argc > 1 && std::string(argv[1]) == "sweep"
+               ? sweep::run_sweep(&argc, &argv, cl.options_files)
+               : run_main(&argc, &argv, wall_start, cl.options_files);
+    }
   } catch (const UserError& e) {
     PetscFPrintf(PETSC_COMM_WORLD, PETSC_STDERR, "morphogen: error: %s\n", e.what());
     rc = 1;
@@ -41,6 +54,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "morphogen: internal error: %s\n", e.what());
     MPI_Abort(PETSC_COMM_WORLD, 2);
   }
+  write_exit_file(rc); // for job scripts (cli/exit_file.hpp)
   // Unused-option warnings are ours (check_unused); keep PETSc quiet about them at exit.
   PetscCall(PetscOptionsSetValue(nullptr, "-options_left", "0"));
   PetscCall(PetscFinalize());

@@ -29,6 +29,69 @@ std::string format_double(double v) {
   return buf;
 }
 
+std::string format_number(double v) {
+  if (std::isnan(v)) return "nan";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  char buf[64];
+  if (v == std::floor(v) && std::abs(v) < 1e7)
+    std::snprintf(buf, sizeof buf, "%.0f", v); // 1000000, not 1e+06
+  else
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+std::string allowed_range(double lo, double hi) {
+  constexpr double big = std::numeric_limits<double>::max();
+  const bool no_lo = lo <= -big, no_hi = hi >= big;
+  if (no_lo && no_hi) return "any number";
+  if (no_hi) return "allowed >= " + format_number(lo);
+  if (no_lo) return "allowed <= " + format_number(hi);
+  return "allowed [" + format_number(lo) + ", " + format_number(hi) + "]";
+}
+
+std::string one_line(const std::string& text) {
+  std::string out;
+  bool space = false;
+  for (char c : text) {
+    if (c == '\n' || c == '\r' || c == '\t' || c == ' ') {
+      space = true;
+      continue;
+    }
+    if (space && !out.empty()) out += ' ';
+    space = false;
+    out += c;
+  }
+  return out;
+}
+
+std::string name_petsc_option_error(const std::string& prefix, const std::string& petsc_message) {
+  char* text = nullptr;
+  if (PetscOptionsGetAll(nullptr, &text) || !text) return {};
+  std::stringstream ss(text);
+  PetscFree(text);
+  std::vector<std::pair<std::string, std::string>> all; // (name, value) under prefix
+  std::string tok;
+  while (ss >> tok) {
+    if (tok.size() > 1 && tok[0] == '-' && std::isalpha(static_cast<unsigned char>(tok[1])))
+      all.emplace_back(tok.substr(1), "");
+    else if (!all.empty())
+      all.back().second += (all.back().second.empty() ? "" : " ") + tok;
+  }
+  const std::string msg = one_line(petsc_message);
+  for (const auto& [name, value] : all) {
+    if (name.compare(0, prefix.size(), prefix) != 0 || value.empty()) continue;
+    if (msg.find(" " + value + " ") == std::string::npos &&
+        msg.find(": " + value) == std::string::npos)
+      continue;
+    const char* what = msg.find("numeric value") != std::string::npos   ? "not a number"
+                       : msg.find("integer value") != std::string::npos ? "not an integer"
+                       : msg.find("logical value") != std::string::npos ? "not true or false"
+                                                                        : "refused";
+    return "-" + name + " " + value + ": " + what + " (PETSc: " + msg + ")";
+  }
+  return {};
+}
+
 size_t edit_distance(const std::string& a, const std::string& b) {
   std::vector<size_t> prev(b.size() + 1), cur(b.size() + 1);
   for (size_t j = 0; j <= b.size(); ++j)
@@ -44,10 +107,20 @@ size_t edit_distance(const std::string& a, const std::string& b) {
   return prev[b.size()];
 }
 
+namespace {
+
+// "allowed [lo, hi]", or "allowed >= lo" when hi is the largest value of its type.
+std::string int_range(PetscInt lo, PetscInt hi) {
+  if (hi == std::numeric_limits<PetscInt>::max()) return "allowed >= " + std::to_string(lo);
+  return "allowed [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+}
+
+} // namespace
+
 Options::Options(MPI_Comm comm) : comm_(comm) {
   PetscBool h = PETSC_FALSE;
   MG_PETSC(PetscOptionsHasName(nullptr, nullptr, "-help", &h));
-  help_ = h;
+  help_ = h || help_everywhere_;
 }
 
 void Options::record(const std::string& name, const std::string& value, const std::string& help) {
@@ -57,21 +130,21 @@ void Options::record(const std::string& name, const std::string& value, const st
       return;
     }
   records_.push_back({name, value, help});
-  if (help_)
-    MG_PETSC(PetscPrintf(comm_, "  -%s <%s>: %s\n", name.c_str(), value.c_str(), help.c_str()));
 }
 
 std::optional<std::string> Options::get(const std::string& name, const std::string& help) {
-  char buf[4096];
+  // The value as stored (no fixed-size buffer: values of any length are read whole).
+  const char* value = nullptr;
   PetscBool set = PETSC_FALSE;
   const std::string key = "-" + name;
-  MG_PETSC(PetscOptionsGetString(nullptr, nullptr, key.c_str(), buf, sizeof buf, &set));
+  MG_PETSC(PetscOptionsFindPair(nullptr, nullptr, key.c_str(), &value, &set));
   if (!set) {
     known_.push_back(name);
     return std::nullopt;
   }
-  record(name, buf, help);
-  return std::string(buf);
+  const std::string v = value ? value : "";
+  record(name, v, help);
+  return v;
 }
 
 bool Options::is_set(const std::string& name) const {
@@ -108,24 +181,24 @@ PetscInt Options::parse_int(const std::string& name, const std::string& text) {
 
 double Options::real(const std::string& name, double def, double lo, double hi,
                      const std::string& help) {
-  const std::string h = help + " [" + format_double(lo) + ", " + format_double(hi) + "]";
+  const std::string h = help + " (" + allowed_range(lo, hi) + ")";
   auto s = get(name, h);
   const double v = s ? parse_real(name, *s) : def;
   if (!(v >= lo && v <= hi))
-    throw UserError("-" + name + " " + (s ? *s : format_double(v)) + ": out of range, allowed [" +
-                    format_double(lo) + ", " + format_double(hi) + "]");
+    throw UserError("-" + name + " " + (s ? *s : format_number(v)) + ": out of range, " +
+                    allowed_range(lo, hi));
   record(name, format_double(v), h);
   return v;
 }
 
 PetscInt Options::integer(const std::string& name, PetscInt def, PetscInt lo, PetscInt hi,
                           const std::string& help) {
-  const std::string h = help + " [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  const std::string h = help + " (" + int_range(lo, hi) + ")";
   auto s = get(name, h);
   const PetscInt v = s ? parse_int(name, *s) : def;
   if (v < lo || v > hi)
-    throw UserError("-" + name + " " + (s ? *s : std::to_string(v)) + ": out of range, allowed [" +
-                    std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    throw UserError("-" + name + " " + (s ? *s : std::to_string(v)) + ": out of range, " +
+                    int_range(lo, hi));
   record(name, std::to_string(v), h);
   return v;
 }
@@ -244,7 +317,10 @@ void Options::check_unused() const {
     msg = "-" + name;
     if (values[i]) msg.append(" ").append(values[i]);
     msg.append(": unknown option (nothing read it)");
-    if (best.empty())
+    const std::string hint = hint_ ? hint_(name) : std::string();
+    if (!hint.empty())
+      msg.append("; ").append(hint);
+    else if (best.empty())
       msg.append("; see -help");
     else
       msg.append("; did you mean -").append(best).append("?");

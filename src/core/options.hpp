@@ -11,6 +11,7 @@
 
 #include <petscsys.h>
 
+#include <functional>
 #include <limits>
 #include <optional>
 #include <string>
@@ -48,7 +49,18 @@ public:
   void known(const std::string& name) { known_.push_back(name); }
 
   const std::vector<Record>& records() const { return records_; }
+  // True with -help in the options database (PETSc's help, `-help petsc`) or after
+  // request_help() (morphogen's own `-help`, which PETSc never sees). Either way the options are
+  // not printed as they are read: the caller prints records() grouped at the end.
   bool help_requested() const { return help_; }
+  // Process-wide: every Options constructed afterwards reports help_requested().
+  static void request_help() { help_everywhere_ = true; }
+
+  // A hint for an unknown option (e.g. "F is a parameter of gray_scott"), or "" for none; used
+  // by check_unused before the "did you mean" suggestion.
+  void set_unknown_hint(std::function<std::string(const std::string& name)> hint) {
+    hint_ = std::move(hint);
+  }
 
   // Throw UserError for the first option set by the user that nothing read.
   void check_unused() const;
@@ -61,8 +73,10 @@ public:
 
 private:
   void record(const std::string& name, const std::string& value, const std::string& help);
+  inline static bool help_everywhere_ = false;
   MPI_Comm comm_;
   bool help_ = false;
+  std::function<std::string(const std::string&)> hint_;
   std::vector<Record> records_;
   std::vector<std::string> known_;
 };
@@ -70,6 +84,25 @@ private:
 // Levenshtein distance (for "did you mean").
 size_t edit_distance(const std::string& a, const std::string& b);
 
+// Shortest text that reads back as exactly v (20, 0.0078125, 1e-12): for files
+// (options_used.yaml, indexes), where full precision matters.
 std::string format_double(double v);
+
+// v for people, in messages: at most 6 significant digits, no trailing zeros
+// (11249.999999999998 -> 11250, 1.7976931348623157e+308 -> 1.79769e+308).
+std::string format_number(double v);
+
+// The allowed range [lo, hi] for messages and help: "allowed [0, 1]", "allowed >= 0" when hi is
+// +inf or the largest double, "allowed <= 1" when lo is -inf or the lowest double, "any number".
+std::string allowed_range(double lo, double hi);
+
+// PETSc's refusal `petsc_message` of an option under `prefix` (e.g. "diffusion_"), said as
+// "-diffusion_ksp_rtol abc: not a number (PETSc: ...)": the option is the one whose value the
+// message quotes. "" when no option under prefix matches.
+std::string name_petsc_option_error(const std::string& prefix, const std::string& petsc_message);
+
+// Each line break (and any run of whitespace around it) in text replaced by one space: a
+// PETSc message made fit for a one-line error.
+std::string one_line(const std::string& text);
 
 } // namespace morphogen

@@ -15,7 +15,7 @@ PetscInt apply_floor(const Grid& grid, std::vector<VecH>& u, const std::vector<d
       for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j) {
         double* r = a + grid.local_index(ob.s[0], j, k);
         for (PetscInt i = 0; i < ob.m[0]; ++i)
-          if (r[i] < floor[s]) r[i] = floor[s], ++changed;
+          if (r[i] < floor[s]) r[i] = floor[s], ++changed; // NaN stays: the guard sees it
       }
     MG_PETSC(VecRestoreArray(u[s], &a));
   }

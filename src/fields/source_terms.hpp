@@ -20,6 +20,7 @@ public:
               std::uint64_t seed, const std::string& base_dir);
 
   bool any() const { return any_; }
+  bool has(int s) const { return spec_[s] != nullptr; }
   // Values of species s at time t, owned layout; nullptr when species s has no source. Two
   // slots (0 and 1) hold two times at once (start and end of a step).
   const double* at(int s, double t, int slot = 0);

@@ -42,6 +42,46 @@ double periodic_delta(double d, double L, bool periodic) {
 
 } // namespace
 
+namespace {
+
+// spots(n, radius, seed): n an integer in [0, kMaxSpots] (each cell tests every spot, so n
+// bounds the cost: 1e5 spots on 256^2 cells is ~1e10 tests), radius finite, seed an integer in
+// [0, 2^53]. A mu::ParserError, reported with the key and the cell by eval_expr.
+void check_spots_args(double n, double radius, double seed) {
+  constexpr double kSeedMax = 9007199254740992.0; // 2^53: every integer exact
+  if (!(n >= 0 && n <= kMaxSpots && n == std::floor(n)))
+    throw mu::ParserError("spots(n, radius, seed): n = " + format_number(n) +
+                          ", allowed an integer in [0, " + std::to_string(kMaxSpots) + "]");
+  if (!std::isfinite(radius))
+    throw mu::ParserError("spots(n, radius, seed): radius = " + format_number(radius) +
+                          ", allowed a finite number");
+  if (!(seed >= 0 && seed <= kSeedMax && seed == std::floor(seed)))
+    throw mu::ParserError("spots(n, radius, seed): seed = " + format_number(seed) +
+                          ", allowed an integer in [0, 2^53]");
+}
+
+// A top-level '=' (an assignment: muParser would assign to x) or ',' (a list: muParser would
+// evaluate every item and keep the last) in an expression: "" if none, else the message.
+std::string top_level_problem(const std::string& expr) {
+  int depth = 0;
+  bool quoted = false;
+  for (size_t p = 0; p < expr.size(); ++p) {
+    const char c = expr[p];
+    if (c == '"') quoted = !quoted;
+    if (quoted) continue;
+    depth += c == '(' ? 1 : c == ')' ? -1 : 0;
+    const char prev = p > 0 ? expr[p - 1] : ' ', next = p + 1 < expr.size() ? expr[p + 1] : ' ';
+    if (c == '=' && prev != '=' && prev != '<' && prev != '>' && prev != '!' && next != '=')
+      return "'=' is an assignment, allowed: one expression (compare with ==)";
+    if (c == ',' && depth == 0)
+      return "a comma-separated list, allowed: one expression (commas only between a "
+             "function's arguments)";
+  }
+  return {};
+}
+
+} // namespace
+
 // muParser callbacks (user data = the ValueSpec being evaluated).
 struct ValueSpecFunctions {
   static ValueSpec& vs(void* p) { return *static_cast<ValueSpec*>(p); }
@@ -65,9 +105,10 @@ struct ValueSpecFunctions {
   }
   static double spots(void* p, double n, double radius, double seed) {
     auto& v = vs(p);
-    const auto s = static_cast<std::uint64_t>(std::llround(seed));
+    check_spots_args(n, radius, seed);
+    const auto s = static_cast<std::uint64_t>(seed);
     const std::uint64_t stream = rng::stream_id("spots");
-    const long count = std::lround(n);
+    const long count = static_cast<long>(n);
     for (long m = 0; m < count; ++m) {
       double d2 = 0;
       for (int d = 0; d < v.grid_.dim; ++d) {
@@ -118,6 +159,8 @@ ValueSpec::ValueSpec(const std::string& key, const std::string& text, const Grid
   }
   expr = trim(expr);
   if (expr.empty()) throw UserError("-" + key + ": empty value");
+  if (const std::string bad = top_level_problem(expr); !bad.empty())
+    throw UserError("-" + key + " " + text + ": " + bad);
 
   // Images named in png("...") are loaded once, up front, so a missing file fails at setup.
   static const std::regex png_re(R"(png\s*\(\s*"([^"]*)\")");

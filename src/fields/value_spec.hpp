@@ -9,13 +9,15 @@
 //             disk(cx, cy, radius)   1 inside the disk (x-y distance), else 0
 //             ball(cx, cy, cz, radius)  1 inside the sphere, else 0
 //             spots(n, radius, seed) 1 inside any of n disks (balls in 3-D) whose centres are
-//                                    hashed from seed (periodic axes use the minimum image)
+//                                    hashed from seed (periodic axes use the minimum image);
+//                                    n an integer in [0, kMaxSpots], seed an integer >= 0
 //             noise()                uniform deviate in [0,1) of this cell
 //             gnoise()               standard normal deviate of this cell
 //             png("file.png", lo, hi)  grey level of an image stretched over the domain
 //                                    (black = lo, white = hi, bilinear)
 //   "+-"    perturbation per cell: uniform in [v - a, v + a] (default) or Gaussian with standard
 //           deviation a ("gauss"); with "%", a is that percentage of |v| at the cell.
+// A value is one expression: a top-level '=' (assignment) or ',' (list) is refused.
 // Random deviates hash (seed, key, global cell index): the field is identical on any rank count.
 #pragma once
 
@@ -32,6 +34,9 @@ class Parser;
 }
 
 namespace morphogen {
+
+// Cap on spots(n, ...): every cell tests every spot, so n bounds the setup time.
+inline constexpr long kMaxSpots = 100000;
 
 class ValueSpec {
 public:

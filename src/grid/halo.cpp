@@ -96,16 +96,16 @@ PetscInt Halo::face_index(int d, PetscInt i, PetscInt j, PetscInt k) const {
   return c[a] + gb.m[a] * c[b];
 }
 
-void Halo::fill_boundaries(double* u, const FaceValues* dirichlet) const {
-  fill_faces(u, dirichlet, {1.0, 1.0, 1.0});
+void Halo::fill_boundaries(double* u, const FaceValues* dirichlet, PetscInt stride) const {
+  fill_faces(u, dirichlet, {1.0, 1.0, 1.0}, stride);
 }
 
 void Halo::fill_mirror(double* u, const std::array<double, 3>& sign) const {
-  fill_faces(u, nullptr, sign);
+  fill_faces(u, nullptr, sign, 1);
 }
 
-void Halo::fill_faces(double* u, const FaceValues* dirichlet,
-                      const std::array<double, 3>& sign) const {
+void Halo::fill_faces(double* u, const FaceValues* dirichlet, const std::array<double, 3>& sign,
+                      PetscInt stride) const {
   const GridSpec& g = grid_.spec();
   const Box& gb = grid_.ghosted();
   const PetscInt str[3] = {1, gb.m[0], gb.m[0] * gb.m[1]};
@@ -127,8 +127,8 @@ void Halo::fill_faces(double* u, const FaceValues* dirichlet,
         for (PetscInt k = lo[2]; k < hi[2]; ++k)
           for (PetscInt j = lo[1]; j < hi[1]; ++j)
             for (PetscInt i = lo[0]; i < hi[0]; ++i) {
-              const PetscInt gi = grid_.local_index(i, j, k);
-              const PetscInt mi = gi + (mirror - ghost) * str[d];
+              const PetscInt gi = stride * grid_.local_index(i, j, k);
+              const PetscInt mi = gi + stride * (mirror - ghost) * str[d];
               u[gi] = dir ? 2.0 * (*vals)[face_index(d, i, j, k)] - u[mi] : sign[d] * u[mi];
             }
       }

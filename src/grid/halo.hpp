@@ -29,8 +29,9 @@ public:
   void begin(double* a) const;
   void end(double* a) const;
   // Fill ghosts outside non-periodic boundaries (after end()). `dirichlet` may be null when no
-  // axis is Dirichlet.
-  void fill_boundaries(double* a, const FaceValues* dirichlet) const;
+  // axis is Dirichlet. With stride n the field is one component of an interlaced local array
+  // (cell c at a[n * c]: a DMDA with n dof and this grid's layout).
+  void fill_boundaries(double* a, const FaceValues* dirichlet, PetscInt stride = 1) const;
   // Fill ghosts outside non-periodic boundaries with the mirror value times sign[d] for the
   // face normal to axis d, whatever the boundary type (coefficient fields: a tensor's
   // off-diagonal component changes sign under a reflection, so its mirror image is odd).
@@ -48,7 +49,8 @@ public:
   PetscInt face_size(int d) const;
 
 private:
-  void fill_faces(double* a, const FaceValues* dirichlet, const std::array<double, 3>& sign) const;
+  void fill_faces(double* a, const FaceValues* dirichlet, const std::array<double, 3>& sign,
+                  PetscInt stride) const;
 
   const Grid& grid_;
   SFH sf_;

@@ -4,6 +4,7 @@
 
 #include "core/collective_error.hpp"
 #include "core/log_events.hpp"
+#include "core/options.hpp"
 #include "core/user_error.hpp"
 
 #include <petscdmda.h>
@@ -76,9 +77,12 @@ void DiffusionSolver::configure(int s) {
   check_type_name("diffusion_ksp_type", KSPList, "KSP");
   check_type_name("diffusion_pc_type", PCList, "PC");
   const std::string err = petsc_quietly([&] { return KSPSetFromOptions(ksp); });
+  if (const std::string named = err.empty() ? "" : name_petsc_option_error("diffusion_", err);
+      !named.empty())
+    throw UserError(named);
   if (!err.empty())
-    throw UserError("-diffusion_ksp_*/-diffusion_pc_* options: PETSc refused them (" + err +
-                    "); see -help for the KSP and PC types");
+    throw UserError("-diffusion_ksp_*/-diffusion_pc_* options: PETSc refused them (" +
+                    one_line(err) + "); see -help petsc for the KSP and PC types");
 }
 
 void DiffusionSolver::prepare_species(int s, double dt, double theta) {

@@ -3,6 +3,7 @@
 #include "core/log_events.hpp"
 
 #include <algorithm>
+#include <exception>
 #include <limits>
 #include <utility>
 
@@ -106,8 +107,77 @@ void ExplicitIntegrator::step_general(std::vector<VecH>& u, std::vector<VecH>& w
   std::swap(u, work);
 }
 
+void ExplicitIntegrator::use_terms(const TermList& terms) {
+  terms_ = &terms;
+  others_.clear();
+  for (const auto& t : terms.terms())
+    if (t->kind() != Term::Kind::Diffusion && t->kind() != Term::Kind::Reaction)
+      others_.push_back(t.get());
+  constrain_after_sweep_ = false; // the fused kernels apply the clamp floor themselves
+  for (const auto& c : terms.constraints())
+    constrain_after_sweep_ = constrain_after_sweep_ || !dynamic_cast<const ClampFloor*>(c.get());
+  rates_.assign(others_.empty() ? 0 : static_cast<size_t>(ns_),
+                std::vector<double>(static_cast<size_t>(grid_.owned().size())));
+}
+
+void ExplicitIntegrator::step(std::vector<VecH>& u, double t, double dt, PetscInt /*step*/) {
+  if (work_.empty())
+    for (int s = 0; s < ns_; ++s)
+      work_.push_back(grid_.create_local());
+  update_ghosts(u);
+  if (others_.empty()) {
+    sweep(u, work_, dt);
+    if (constrain_after_sweep_) terms_->constrain(u);
+    return;
+  }
+  // Rates of the other terms on u^n (ghosts current), added after the sweep.
+  StateArrays state;
+  RateArrays rates;
+  std::vector<const PetscScalar*> in(ns_);
+  for (int s = 0; s < ns_; ++s) {
+    MG_PETSC(VecGetArrayRead(u[s], &in[s]));
+    state.u.push_back(in[s]);
+    std::fill(rates_[s].begin(), rates_[s].end(), 0.0);
+    rates.r.push_back(rates_[s].data());
+  }
+  std::exception_ptr error;
+  try {
+    for (const Term* term : others_)
+      term->add_rates(state, t, rates);
+  } catch (...) {
+    error = std::current_exception();
+  }
+  for (int s = 0; s < ns_; ++s)
+    MG_PETSC(VecRestoreArrayRead(u[s], &in[s]));
+  if (error) std::rethrow_exception(error);
+  sweep(u, work_, dt);
+  add_other_terms(u, t, dt);
+}
+
+// u += dt r on the owned cells, then the constraints.
+void ExplicitIntegrator::add_other_terms(std::vector<VecH>& u, double /*t*/, double dt) {
+  const Box& ob = grid_.owned();
+  for (int s = 0; s < ns_; ++s) {
+    PetscScalar* a;
+    MG_PETSC(VecGetArray(u[s], &a));
+    for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
+      for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j) {
+        double* row = a + grid_.local_index(ob.s[0], j, k);
+        const double* r = rates_[s].data() + grid_.owned_index(ob.s[0], j, k);
+        for (PetscInt i = 0; i < ob.m[0]; ++i)
+          row[i] += dt * r[i];
+      }
+    MG_PETSC(VecRestoreArray(u[s], &a));
+  }
+  if (terms_) terms_->constrain(u);
+}
+
 void ExplicitIntegrator::step(std::vector<VecH>& u, std::vector<VecH>& work, double dt) const {
   update_ghosts(u);
+  sweep(u, work, dt);
+}
+
+void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>& work, double dt) const {
   if (!ops_.empty()) {
     step_general(u, work, dt);
     return;

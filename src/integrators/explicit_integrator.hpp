@@ -12,19 +12,24 @@
 // diffusion (DiffusionOperator::apply_row) goes into a row buffer, then the model's
 // explicit_row_pre adds the reaction and writes the row, so the tile stays in cache; stable for
 // dt <= 2 / max_s radius_s (lambda_max of the tensors over the grid).
+// Other terms of the run (sources, ...: use_terms) are evaluated on u^n after the halo update,
+// and dt times their rates is added after the sweep, followed by the run's constraints:
+//   u^{n+1} = C( sweep(u^n) + dt sum_k T_k(u^n, t) )
 #pragma once
 
 #include "fields/param_set.hpp"
 #include "grid/halo.hpp"
 #include "grid/stencil.hpp"
 #include "integrators/explicit_kernel.hpp"
+#include "integrators/integrator.hpp"
 #include "operators/diffusion_operator.hpp"
+#include "operators/term_list.hpp"
 
 #include <vector>
 
 namespace morphogen {
 
-class ExplicitIntegrator {
+class ExplicitIntegrator : public Integrator {
 public:
   using RowFn = void (*)(const ExplicitRow&);
   // row_fn must match (nspecies, nparams, the stencil's row form, params.any_field()).
@@ -36,6 +41,11 @@ public:
   void update_ghosts(std::vector<VecH>& u) const;
   // One step: u <- u + dt (D L u + R(u)); `work` is a second set of ghosted local Vecs.
   void step(std::vector<VecH>& u, std::vector<VecH>& work, double dt) const;
+  // One step of the whole run: the sweep, the other terms and the constraints (use_terms).
+  void step(std::vector<VecH>& u, double t, double dt, PetscInt step) override;
+  // The run's terms besides diffusion and reaction (evaluated through Term::add_rates) and its
+  // constraints; keeps a reference to `terms`.
+  void use_terms(const TermList& terms);
 
   // Largest stable dt for this stencil and these diffusion coefficients (inf if D = 0).
   static double stable_dt(const Stencil& stencil, const std::vector<double>& D);
@@ -49,6 +59,8 @@ public:
   bool general() const { return !ops_.empty(); }
 
 private:
+  void sweep(std::vector<VecH>& u, std::vector<VecH>& work, double dt) const;
+  void add_other_terms(std::vector<VecH>& u, double t, double dt);
   void step_general(std::vector<VecH>& u, std::vector<VecH>& work, double dt) const;
 
   const Grid& grid_;
@@ -64,6 +76,11 @@ private:
   std::vector<const DiffusionOperator*> ops_;   // general path (empty: fused fast path)
   RowFn pre_fn_ = nullptr;
   mutable std::vector<std::vector<double>> div_; // per species row buffer of the general path
+  const TermList* terms_ = nullptr;
+  std::vector<const Term*> others_;        // terms evaluated through add_rates
+  bool constrain_after_sweep_ = false;     // constraints other than the kernel's clamp floor
+  std::vector<VecH> work_;                 // second state set (created on the first step)
+  std::vector<std::vector<double>> rates_; // owned layout, per species (other terms)
 };
 
 } // namespace morphogen

@@ -16,6 +16,8 @@
 // refuses to vectorise.)
 #pragma once
 
+#include "fields/clamp_kernel.hpp"
+
 namespace morphogen {
 
 struct ExplicitRow {
@@ -80,7 +82,7 @@ inline void explicit_row(const ExplicitRow& a) {
           lap += w[q][1] * row[i];
       }
       const double v = u[s] + dt * (D[s] * lap + r[s]);
-      dst[s][i] = v > floor[s] ? v : floor[s];
+      dst[s][i] = clamp_to_floor(v, floor[s]);
     }
   }
 }
@@ -125,7 +127,7 @@ template <class M, bool FieldParams> inline void explicit_row_pre(const Explicit
     M::rates(u, p, r);
     for (int s = 0; s < NS; ++s) {
       const double v = u[s] + dt * (div[s][i] + r[s]);
-      dst[s][i] = v > floor[s] ? v : floor[s];
+      dst[s][i] = clamp_to_floor(v, floor[s]);
     }
   }
 }

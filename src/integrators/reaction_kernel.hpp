@@ -44,6 +44,8 @@
 // each cell's inputs are read before its outputs are written.
 #pragma once
 
+#include "fields/clamp_kernel.hpp"
+
 #include <cmath>
 #include <limits>
 
@@ -300,7 +302,7 @@ inline int reaction_row(ReactionScheme scheme, int n, const double* const* u,
     if (cs.iterations > acc.iterations) acc.iterations = cs.iterations;
     if (cs.residual > acc.residual) acc.residual = cs.residual;
     for (int s = 0; s < NS; ++s)
-      out[s][i] = v[s] > floor[s] ? v[s] : floor[s];
+      out[s][i] = clamp_to_floor(v[s], floor[s]);
   }
   if (worst) *worst = acc;
   return -1;

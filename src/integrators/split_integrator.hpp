@@ -17,6 +17,7 @@
 #include "fields/param_set.hpp"
 #include "fields/source_terms.hpp"
 #include "integrators/diffusion_solver.hpp"
+#include "integrators/integrator.hpp"
 #include "integrators/reaction_kernel.hpp"
 
 #include <vector>
@@ -45,14 +46,14 @@ struct SplitSettings {
   int newton_max_it = 20;
 };
 
-class SplitIntegrator {
+class SplitIntegrator : public Integrator {
 public:
   SplitIntegrator(const Grid& grid, ReactionRowFn fn, const std::vector<std::string>& species,
                   const ParamSet& params, std::vector<double> floor, SourceTerms* sources,
                   DiffusionSolver& diffusion, const SplitSettings& settings);
 
   // One step from t to t + dt on the ghosted local state vectors (owned cells updated).
-  void step(std::vector<VecH>& u, double t, double dt, PetscInt step);
+  void step(std::vector<VecH>& u, double t, double dt, PetscInt step) override;
 
   // Largest Newton iteration count of the last reaction substep.
   int last_newton_iterations() const { return last_its_; }

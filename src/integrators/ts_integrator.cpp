@@ -1,10 +1,11 @@
 #include "integrators/ts_integrator.hpp"
 
-#include "fields/clamp_floor.hpp"
 #include "integrators/ksp_defaults.hpp"
 
 #include "core/log_events.hpp"
 #include "core/user_error.hpp"
+
+#include <petscdmda.h>
 
 #include <algorithm>
 #include <cmath>
@@ -26,21 +27,29 @@ struct QuietPetscErrors {
 
 } // namespace
 
-TsIntegrator::TsIntegrator(const Grid& grid, RatesFn rates, const std::vector<std::string>& species,
-                           const ParamSet& params, std::vector<double> floor,
-                           const OperatorMatrices& ops, SourceTerms* sources, double dt)
-    : grid_(grid), rates_(rates), species_(species), params_(params), floor_(std::move(floor)),
-      ops_(ops), sources_(sources) {
+TsIntegrator::TsIntegrator(const Grid& grid, const Halo& halo,
+                           const std::vector<std::string>& species, const TermList& terms,
+                           const OperatorMatrices* ops, const std::vector<FaceValues>* dirichlet,
+                           double dt)
+    : grid_(grid), halo_(halo), species_(species), terms_(terms), ops_(ops), dirichlet_(dirichlet) {
   ns_ = static_cast<PetscInt>(species.size());
   nloc_ = grid.owned().size();
-  if (ops_.nspecies() != static_cast<int>(species.size()) || floor_.size() != species.size() ||
-      params_.scalar.size() != params_.field.size() || !rates_)
-    throw std::logic_error("TsIntegrator: species, D, floor or parameter sizes disagree");
-  cell_u_.assign(species.size(), 0.0);
-  cell_r_.assign(species.size(), 0.0);
-  cell_p_.assign(params_.scalar.size(), 0.0);
+  terms_.diffusion(static_cast<int>(ns_)); // throws unless one diffusion term per species
+  if (ops_ && ops_->nspecies() != static_cast<int>(ns_))
+    throw std::logic_error("TsIntegrator: species and operator matrices disagree");
+  for (const auto& t : terms_.terms())
+    if (!(ops_ && t->kind() == Term::Kind::Diffusion)) rhs_.push_back(t.get());
+  for (const Term* t : rhs_) {
+    rhs_halo_.width = std::max(rhs_halo_.width, t->halo().width);
+    rhs_halo_.box = rhs_halo_.box || t->halo().box;
+  }
+  if (rhs_halo_.width > grid.spec().stencil_width || (rhs_halo_.box && !grid.spec().box_stencil))
+    throw std::logic_error("TsIntegrator: a term needs more halo than the grid has");
+  MG_PETSC(DMDACreateCompatibleDMDA(grid.dm(), ns_, dm_.out()));
+  MG_PETSC(DMCreateGlobalVector(dm_, X_.out()));
+  MG_PETSC(VecSet(X_, 0.0));
   try {
-    build_operator();
+    if (ops_) build_operator();
     setup_ts(dt);
   } catch (...) {
     ts_.reset();
@@ -50,7 +59,7 @@ TsIntegrator::TsIntegrator(const Grid& grid, RatesFn rates, const std::vector<st
   }
 }
 
-// blockdiag(D_s L) in the block layout, the block Dirichlet vector and the block state.
+// K = blockdiag(scale_s M_s) in the interlaced numbering, and the interlaced Dirichlet data.
 void TsIntegrator::build_operator() {
   MPI_Comm comm = grid_.comm();
   int size = 1, rank = 0;
@@ -66,16 +75,13 @@ void TsIntegrator::build_operator() {
   }
   const PetscInt rstart = ranges[rank], rend = ranges[rank + 1];
   if (rend - rstart != nloc_) throw std::logic_error("TsIntegrator: DMDA ownership mismatch");
-  const PetscInt nb = ns_ * nloc_, bstart = ns_ * rstart;
-  // DMDA global index g owned by rank r -> index of species s in the block layout.
-  auto block_col = [&](PetscInt g, PetscInt s) {
-    const auto r = std::upper_bound(ranges.begin(), ranges.end(), g) - ranges.begin() - 1;
-    return ns_ * ranges[r] + s * (ranges[r + 1] - ranges[r]) + (g - ranges[r]);
-  };
+  const PetscInt nb = ns_ * nloc_;
+  // Cell g of the scalar DMDA, species s -> row/column of the interlaced DMDA.
+  auto block_col = [&](PetscInt g, PetscInt s) { return ns_ * g + s; };
 
   std::vector<PetscInt> dnz(static_cast<size_t>(nb)), onz(static_cast<size_t>(nb));
   for (PetscInt s = 0; s < ns_; ++s) {
-    Mat L = ops_.M(static_cast<int>(s));
+    Mat L = ops_->M(static_cast<int>(s));
     for (PetscInt g = rstart; g < rend; ++g) {
       PetscInt nc = 0;
       const PetscInt* cols = nullptr;
@@ -85,8 +91,8 @@ void TsIntegrator::build_operator() {
         d += cols[c] >= rstart && cols[c] < rend;
       const PetscInt o = nc - d;
       MG_PETSC(MatRestoreRow(L, g, &nc, &cols, nullptr)); // (zeroes nc)
-      dnz[static_cast<size_t>(s * nloc_ + g - rstart)] = d;
-      onz[static_cast<size_t>(s * nloc_ + g - rstart)] = o;
+      dnz[static_cast<size_t>(ns_ * (g - rstart) + s)] = d;
+      onz[static_cast<size_t>(ns_ * (g - rstart) + s)] = o;
     }
   }
   MG_PETSC(MatCreate(comm, Dblock_.out()));
@@ -97,8 +103,8 @@ void TsIntegrator::build_operator() {
   std::vector<PetscInt> bcols;
   std::vector<PetscScalar> bvals;
   for (PetscInt s = 0; s < ns_; ++s) {
-    Mat L = ops_.M(static_cast<int>(s));
-    const double scale = ops_.scale(static_cast<int>(s));
+    Mat L = ops_->M(static_cast<int>(s));
+    const double scale = ops_->scale(static_cast<int>(s));
     for (PetscInt g = rstart; g < rend; ++g) {
       PetscInt nc = 0;
       const PetscInt* cols = nullptr;
@@ -106,7 +112,7 @@ void TsIntegrator::build_operator() {
       MG_PETSC(MatGetRow(L, g, &nc, &cols, &vals));
       bcols.resize(static_cast<size_t>(nc));
       bvals.resize(static_cast<size_t>(nc));
-      const PetscInt row = bstart + s * nloc_ + (g - rstart);
+      const PetscInt row = block_col(g, s);
       for (PetscInt c = 0; c < nc; ++c) {
         bcols[static_cast<size_t>(c)] = block_col(cols[c], s);
         bvals[static_cast<size_t>(c)] = scale * vals[c];
@@ -120,24 +126,20 @@ void TsIntegrator::build_operator() {
   MG_PETSC(MatAssemblyEnd(Dblock_, MAT_FINAL_ASSEMBLY));
   MG_PETSC(MatDuplicate(Dblock_, MAT_COPY_VALUES, J_.out()));
 
-  // Block state X and block Dirichlet vector D_s b_s.
-  MG_PETSC(VecCreate(comm, X_.out()));
-  MG_PETSC(VecSetSizes(X_, nb, PETSC_DETERMINE));
-  MG_PETSC(VecSetType(X_, VECSTANDARD));
-  MG_PETSC(VecSet(X_, 0.0));
+  // Interlaced Dirichlet data scale_s b_s.
   MG_PETSC(VecDuplicate(X_, bD_.out()));
   PetscScalar* bd = nullptr;
   MG_PETSC(VecGetArray(bD_, &bd));
   int local_b = 0;
   for (PetscInt s = 0; s < ns_; ++s) {
     const PetscScalar* b = nullptr;
-    const double scale = ops_.scale(static_cast<int>(s));
-    MG_PETSC(VecGetArrayRead(ops_.b(static_cast<int>(s)), &b));
+    const double scale = ops_->scale(static_cast<int>(s));
+    MG_PETSC(VecGetArrayRead(ops_->b(static_cast<int>(s)), &b));
     for (PetscInt c = 0; c < nloc_; ++c) {
-      bd[s * nloc_ + c] = scale * b[c];
-      local_b |= bd[s * nloc_ + c] != 0.0;
+      bd[ns_ * c + s] = scale * b[c];
+      local_b |= bd[ns_ * c + s] != 0.0;
     }
-    MG_PETSC(VecRestoreArrayRead(ops_.b(static_cast<int>(s)), &b));
+    MG_PETSC(VecRestoreArrayRead(ops_->b(static_cast<int>(s)), &b));
   }
   MG_PETSC(VecRestoreArray(bD_, &bd));
   int any_b = 0;
@@ -146,16 +148,16 @@ void TsIntegrator::build_operator() {
 }
 
 void TsIntegrator::setup_ts(double dt) {
-  MPI_Comm comm = grid_.comm();
-  int size = 1;
-  MPI_Comm_size(comm, &size);
-  MG_PETSC(TSCreate(comm, ts_.out()));
-  MG_PETSC(TSSetType(ts_, TSARKIMEX));
-  MG_PETSC(TSARKIMEXSetType(ts_, TSARKIMEX2E));
+  MG_PETSC(TSCreate(grid_.comm(), ts_.out()));
+  MG_PETSC(TSSetDM(ts_, dm_));
+  MG_PETSC(TSSetType(ts_, ops_ ? TSARKIMEX : TSRK));
+  if (ops_) MG_PETSC(TSARKIMEXSetType(ts_, TSARKIMEX2E));
   MG_PETSC(TSSetProblemType(ts_, TS_NONLINEAR));
-  MG_PETSC(TSSetIFunction(ts_, nullptr, ifunction_cb, this));
+  if (ops_) {
+    MG_PETSC(TSSetIFunction(ts_, nullptr, ifunction_cb, this));
+    MG_PETSC(TSSetIJacobian(ts_, J_, J_, ijacobian_cb, this));
+  }
   MG_PETSC(TSSetRHSFunction(ts_, nullptr, rhsfunction_cb, this));
-  MG_PETSC(TSSetIJacobian(ts_, J_, J_, ijacobian_cb, this));
   MG_PETSC(TSSetSolution(ts_, X_));
   MG_PETSC(TSSetTime(ts_, 0.0));
   MG_PETSC(TSSetTimeStep(ts_, dt));
@@ -171,61 +173,86 @@ void TsIntegrator::setup_ts(double dt) {
   SNES snes;
   MG_PETSC(TSGetSNES(ts_, &snes));
   MG_PETSC(SNESSetType(snes, SNESKSPONLY));
-  KSP ksp;
-  MG_PETSC(SNESGetKSP(snes, &ksp));
-  bool symmetric = true;
-  for (int s = 0; s < ops_.nspecies(); ++s)
-    symmetric = symmetric && ops_.symmetric(s);
-  if (symmetric) {
-    set_cg_icc(ksp);
-  } else { // first-order tensor masks: a non-symmetric operator
-    int size = 1;
-    MPI_Comm_size(grid_.comm(), &size);
-    MG_PETSC(KSPSetType(ksp, KSPGMRES));
-    PC pc;
-    MG_PETSC(KSPGetPC(ksp, &pc));
-    MG_PETSC(PCSetType(pc, size == 1 ? PCILU : PCBJACOBI));
-  }
-  MG_PETSC(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, 10000));
-  MG_PETSC(TSSetFromOptions(ts_));
+  // A misspelt type or value is the user's: one line naming PETSc's complaint.
+  const std::string err = petsc_quietly([&] { return TSSetFromOptions(ts_); });
+  if (!err.empty())
+    throw UserError("PETSc options of -integrator ts (-ts_*, -snes_*, -ksp_*, -pc_*): " + err);
+  check_type();
+  MG_PETSC(TSGetAdapt(ts_, &adapt));
+  PetscBool none = PETSC_FALSE;
+  MG_PETSC(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(adapt), TSADAPTNONE, &none));
+  adaptive_ = !none;
+  next_dt_ = dt;
+  if (ops_) setup_implicit_solver(dt);
+}
 
+// Explicit TS types cannot take the implicit diffusion; with explicit diffusion there is no
+// implicit part, so implicit types are refused instead.
+void TsIntegrator::check_type() {
   TSType type = nullptr;
   MG_PETSC(TSGetType(ts_, &type));
   const std::string tname = type ? type : "";
-  for (const char* explicit_type : {TSEULER, TSRK, TSSSP, TSMPRK, TSBASICSYMPLECTIC, TSPSEUDO})
-    if (tname == explicit_type)
-      throw UserError("-ts_type " + tname +
-                      ": an explicit (or pseudo-transient) TS type cannot take the implicit "
-                      "diffusion part; use arkimex (default), rosw, or an implicit type such as "
-                      "bdf, cn, beuler or theta");
+  bool explicit_type = false;
+  for (const char* e : {TSEULER, TSRK, TSSSP, TSMPRK, TSBASICSYMPLECTIC, TSPSEUDO})
+    explicit_type = explicit_type || tname == e;
+  if (ops_ && explicit_type)
+    throw UserError("-ts_type " + tname +
+                    ": an explicit (or pseudo-transient) TS type cannot take the implicit "
+                    "diffusion part; use arkimex (default), rosw, or an implicit type such as "
+                    "bdf, cn, beuler or theta, or -ts_diffusion explicit");
+  if (!ops_ && (!explicit_type || tname == TSPSEUDO))
+    throw UserError("-ts_type " + tname +
+                    ": with -ts_diffusion explicit every term is explicit; use an explicit type: "
+                    "rk (default), euler or ssp");
+}
+
+// KSP (and SNES for fully implicit types) of the implicit diffusion part.
+void TsIntegrator::setup_implicit_solver(double dt) {
+  TSType type = nullptr;
+  MG_PETSC(TSGetType(ts_, &type));
+  const std::string tname = type ? type : "";
+  SNES snes;
+  KSP ksp;
+  MG_PETSC(TSGetSNES(ts_, &snes));
+  MG_PETSC(SNESGetKSP(snes, &ksp));
+  bool symmetric = true;
+  for (int s = 0; s < ops_->nspecies(); ++s)
+    symmetric = symmetric && ops_->symmetric(s);
   // ksponly is exact only when the implicit part is the linear diffusion: IMEX schemes. Fully
   // implicit schemes also put the reaction into the solve, which then needs Newton (with the
   // diffusion Jacobian only, so it converges linearly at a rate ~ dt |dR/du|).
   PetscBool fully_implicit = PETSC_FALSE;
   if (tname == TSARKIMEX) MG_PETSC(TSARKIMEXGetFullyImplicit(ts_, &fully_implicit));
   const bool imex = (tname == TSARKIMEX && !fully_implicit) || tname == TSROSW || tname == TSEIMEX;
-  PetscBool user_snes = PETSC_FALSE;
+  PetscBool user_snes = PETSC_FALSE, user_ksp = PETSC_FALSE, user_pc = PETSC_FALSE;
   MG_PETSC(PetscOptionsHasName(nullptr, nullptr, "-snes_type", &user_snes));
+  MG_PETSC(PetscOptionsHasName(nullptr, nullptr, "-ksp_type", &user_ksp));
+  MG_PETSC(PetscOptionsHasName(nullptr, nullptr, "-pc_type", &user_pc));
   if (!imex && !user_snes) MG_PETSC(SNESSetType(snes, SNESNEWTONLS));
-
-  MG_PETSC(TSGetAdapt(ts_, &adapt));
-  PetscBool none = PETSC_FALSE;
-  MG_PETSC(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(adapt), TSADAPTNONE, &none));
-  adaptive_ = !none;
-  next_dt_ = dt;
-
+  int size = 1;
+  MPI_Comm_size(grid_.comm(), &size);
+  PC pc;
+  MG_PETSC(KSPGetPC(ksp, &pc));
+  if (symmetric) {
+    if (!user_ksp) MG_PETSC(KSPSetType(ksp, KSPCG));
+    if (!user_pc) MG_PETSC(PCSetType(pc, size == 1 ? PCICC : PCBJACOBI));
+  } else { // first-order tensor masks: a non-symmetric operator
+    if (!user_ksp) MG_PETSC(KSPSetType(ksp, KSPGMRES));
+    if (!user_pc) MG_PETSC(PCSetType(pc, size == 1 ? PCILU : PCBJACOBI));
+  }
+  PetscBool user_rtol = PETSC_FALSE;
+  MG_PETSC(PetscOptionsHasName(nullptr, nullptr, "-ksp_rtol", &user_rtol));
+  if (!user_rtol) MG_PETSC(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, 10000));
   // Set the linear solver up now, on an operator of the final pattern, so that the parallel
   // default (ICC blocks) can be installed and every -ksp_/-pc_/-sub_ option is read before the
   // caller checks for unused options. The values are refreshed by the first IJacobian call.
-  MG_PETSC(TSGetSNES(ts_, &snes));
-  MG_PETSC(SNESGetKSP(snes, &ksp));
   MG_PETSC(fill_jacobian(1.0 / dt));
   jac_shift_ = -1; // force a refresh on the first call
   MG_PETSC(KSPSetOperators(ksp, J_, J_));
-  bool all_symmetric = true;
-  for (int s = 0; s < ops_.nspecies(); ++s)
-    all_symmetric = all_symmetric && ops_.symmetric(s);
-  if (all_symmetric)
+  const std::string err = petsc_quietly([&] { return KSPSetFromOptions(ksp); });
+  if (!err.empty())
+    throw UserError("PETSc options of the TS linear solver (-ksp_*, -pc_*): " + err);
+  if (symmetric)
     icc_subblocks(ksp, "-sub_pc_type");
   else
     MG_PETSC(KSPSetUp(ksp));
@@ -273,43 +300,47 @@ PetscErrorCode TsIntegrator::ifunction(Vec X, Vec Xdot, Vec F) {
   PetscFunctionReturn(0);
 }
 
-// G(t, X) = R(X; p) + S(x, t), cell by cell.
+// G(t, X) = the sum of the right-hand-side terms, on a ghosted local copy of X.
 PetscErrorCode TsIntegrator::rhsfunction(PetscReal t, Vec X, Vec G) {
   PetscFunctionBeginUser;
-  LogScope log_scope(log_events().reaction);
-  const size_t ns = static_cast<size_t>(ns_), np = params_.scalar.size();
-  // Source values first: their evaluation may throw (a bad expression value), before any array
-  // is taken from PETSc.
-  std::vector<const double*> S(ns, nullptr);
-  if (sources_ && sources_->any())
-    for (size_t s = 0; s < ns; ++s)
-      S[s] = sources_->at(static_cast<int>(s), t, 0);
-  std::vector<const PetscScalar*> pf(np, nullptr);
-  for (size_t q = 0; q < np; ++q)
-    if (params_.field[q].get()) PetscCall(VecGetArrayRead(params_.field[q], &pf[q]));
-  for (size_t q = 0; q < np; ++q)
-    cell_p_[q] = params_.scalar[q];
-  const PetscScalar* x = nullptr;
+  Vec Xl = nullptr;
+  PetscCall(DMGetLocalVector(dm_, &Xl));
+  PetscCall(DMGlobalToLocalBegin(dm_, X, INSERT_VALUES, Xl));
+  PetscCall(DMGlobalToLocalEnd(dm_, X, INSERT_VALUES, Xl));
+  PetscScalar* xl = nullptr;
   PetscScalar* g = nullptr;
-  PetscCall(VecGetArrayRead(X, &x));
+  PetscCall(VecGetArray(Xl, &xl));
   PetscCall(VecGetArray(G, &g));
-  double* u = cell_u_.data();
-  double* p = cell_p_.data();
-  double* r = cell_r_.data();
-  for (PetscInt c = 0; c < nloc_; ++c) {
-    for (size_t s = 0; s < ns; ++s)
-      u[s] = x[static_cast<PetscInt>(s) * nloc_ + c];
-    for (size_t q = 0; q < np; ++q)
-      if (pf[q]) p[q] = pf[q][c];
-    rates_(u, p, r);
-    for (size_t s = 0; s < ns; ++s)
-      g[static_cast<PetscInt>(s) * nloc_ + c] = r[s] + (S[s] ? S[s][c] : 0.0);
+  PetscCall(PetscArrayzero(g, ns_ * nloc_));
+  std::exception_ptr error;
+  try {
+    add_rhs_terms(xl, t, g);
+  } catch (...) { // arrays go back to PETSc before the error is reported
+    error = std::current_exception();
   }
   PetscCall(VecRestoreArray(G, &g));
-  PetscCall(VecRestoreArrayRead(X, &x));
-  for (size_t q = 0; q < np; ++q)
-    if (pf[q]) PetscCall(VecRestoreArrayRead(params_.field[q], &pf[q]));
+  PetscCall(VecRestoreArray(Xl, &xl));
+  PetscCall(DMRestoreLocalVector(dm_, &Xl));
+  if (error) std::rethrow_exception(error); // recorded by the callback wrapper
   PetscFunctionReturn(0);
+}
+
+void TsIntegrator::add_rhs_terms(const PetscScalar* xl, double t, PetscScalar* g) const {
+  StateArrays state;
+  RateArrays rates;
+  state.stride = rates.stride = ns_;
+  for (PetscInt s = 0; s < ns_; ++s) {
+    state.u.push_back(xl + s);
+    rates.r.push_back(g + s);
+  }
+  if (rhs_halo_.width > 0) // ghosts outside non-periodic faces (the local copy is ours)
+    for (PetscInt s = 0; s < ns_; ++s)
+      halo_.fill_boundaries(
+          const_cast<double*>(xl) + s,
+          dirichlet_ && !dirichlet_->empty() ? &(*dirichlet_)[static_cast<size_t>(s)] : nullptr,
+          ns_);
+  for (const Term* term : rhs_)
+    term->add_rates(state, t, rates);
 }
 
 // J = shift I - blockdiag(D_s L), refreshed only when the shift changed.
@@ -348,12 +379,14 @@ bool TsIntegrator::copy_state(std::vector<VecH>& u, bool to_x) {
     for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
       for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j) {
         double* lr = l + grid_.local_index(ob.s[0], j, k);
-        double* xr = x + s * nloc_ + grid_.owned_index(ob.s[0], j, k);
-        if (to_x) {
-          if (!changed && !std::equal(lr, lr + ob.m[0], xr)) changed = true;
-          std::copy(lr, lr + ob.m[0], xr);
-        } else {
-          std::copy(xr, xr + ob.m[0], lr);
+        double* xr = x + ns_ * grid_.owned_index(ob.s[0], j, k) + s;
+        for (PetscInt i = 0; i < ob.m[0]; ++i) {
+          if (to_x) {
+            changed = changed || xr[ns_ * i] != lr[i];
+            xr[ns_ * i] = lr[i];
+          } else {
+            lr[i] = xr[ns_ * i];
+          }
         }
       }
     MG_PETSC(VecRestoreArray(u[static_cast<size_t>(s)], &l));
@@ -454,7 +487,7 @@ void TsIntegrator::step(std::vector<VecH>& u, double t, double dt, PetscInt step
     if (h > 0 && std::isfinite(h)) next_dt_ = h;
   }
   copy_state(u, false);
-  apply_floor(grid_, u, floor_);
+  terms_.constrain(u);
 }
 
 } // namespace morphogen

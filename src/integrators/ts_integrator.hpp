@@ -1,17 +1,21 @@
-// PETSc TS integrator (IMEX additive Runge-Kutta):
+// PETSc TS integrator on a DM (TSSetDM): the run's term list (operators/term_list.hpp) as
 //
-//   du_s/dt = K_s u_s                      (implicit: stiff, linear; the species' diffusion
-//                                           operator scale_s (M_s u + b_s))
-//           + R_s(u; p) + S_s(x, t)        (explicit: reaction and source terms, cell by cell)
+//   du/dt = K u + b                 (implicit: the diffusion terms, linear; K = blockdiag of
+//                                    the species' operators scale_s (M_s u + b_s), from
+//                                    operators/operator_matrices.hpp)
+//         + G(u, x, t)              (explicit right-hand side: every other term, reaction and
+//                                    sources included, evaluated on a ghosted copy of the state)
 //
-// M_s, scale_s and b_s come from operators/operator_matrices.hpp (the explicit scheme's
-// operator with the boundary conditions folded in).
+// With -ts_diffusion explicit the diffusion terms join G instead (no implicit part): explicit
+// TS types only (euler, rk, ssp), e.g. classical RK4 with -ts_type rk -ts_rk_type 4.
 //
-// Layout: one MPI Vec X holds every species; this rank's block is species 0's owned cells
-// (owned layout, x fastest), then species 1's, ... (local size nspecies * owned cells). The
-// implicit operator is blockdiag(scale_s M_s) in that layout, assembled once by copying the rows
-// with column indices mapped to the block layout; the IJacobian shift*I - blockdiag(D_s L) is
-// refreshed from it only when the shift changes (so a fixed dt factors the preconditioner once).
+// Layout: the state X is a global Vec of a DMDA with one dof per species (interlaced,
+// DMDACreateCompatibleDMDA of the run's grid: same decomposition and stencil). The right-hand
+// side scatters X to a local Vec with DMGlobalToLocal (inter-rank and periodic ghosts), fills the
+// ghosts outside non-periodic faces (zero flux, Dirichlet data), and lets each term add its
+// rates. The implicit operator K is assembled once in the interlaced numbering (row
+// nspecies * g + s for cell g of the scalar DMDA); the IJacobian shift*I - K is refreshed from it
+// only when the shift changes (so a fixed dt factors the preconditioner once).
 //
 // Defaults (all overridable from the options database, no prefix: -ts_*, -snes_*, -ksp_*,
 // -pc_*, -sub_pc_*):
@@ -29,9 +33,11 @@
 //     so one linear solve per stage is exact. Fully implicit types (-ts_type bdf, cn, beuler,
 //     theta, ..., or -ts_arkimex_fully_implicit) also put the reaction into the solve: for
 //     them the default becomes -snes_type newtonls, with the diffusion-only Jacobian (modified
-//     Newton, converging at a rate ~ dt |dR/du|). Explicit types (euler, rk, ssp) are refused.
+//     Newton, converging at a rate ~ dt |dR/du|). Explicit types (euler, rk, ssp) are refused
+//     unless -ts_diffusion explicit (then the default is -ts_type rk, PETSc's 3bs).
 //   -ksp_type cg, -pc_type icc on one rank / bjacobi with icc blocks in parallel (unless
-//     -sub_pc_type is given), -ksp_rtol 1e-10.
+//     -sub_pc_type is given), -ksp_rtol 1e-10; GMRES + ILU for non-symmetric operators
+//     (first-order tensor masks).
 // Consecutive step() calls continue one TS integration (multistep schemes keep their history)
 // unless the state or the time changed in between (the clamp floor acted, or a restart): then
 // the step is restarted (TSRestartStep).
@@ -40,9 +46,9 @@
 // and step() rethrows it after TSSolve returns.
 #pragma once
 
-#include "fields/param_set.hpp"
-#include "fields/source_terms.hpp"
+#include "integrators/integrator.hpp"
 #include "operators/operator_matrices.hpp"
+#include "operators/term_list.hpp"
 
 #include <exception>
 #include <petscts.h>
@@ -51,27 +57,28 @@
 
 namespace morphogen {
 
-class TsIntegrator {
+class TsIntegrator : public Integrator {
 public:
-  using RatesFn = void (*)(const double* u, const double* p, double* r);
-
-  // D and floor have one entry per species (floor -inf: no clamp). `sources` may be null. dt is
-  // the step of step() calls (and the largest internal step when adaptive); the integrator
-  // keeps references to grid, params, lap and sources.
-  TsIntegrator(const Grid& grid, RatesFn rates, const std::vector<std::string>& species,
-               const ParamSet& params, std::vector<double> floor, const OperatorMatrices& ops,
-               SourceTerms* sources, double dt);
+  // `terms` holds one diffusion term per species; `ops` their matrices (boundary conditions
+  // folded in), or null for -ts_diffusion explicit (diffusion in the right-hand side). dt is
+  // the step of step() calls (and the largest internal step when adaptive). The integrator
+  // keeps references to grid, halo, terms, ops and dirichlet.
+  TsIntegrator(const Grid& grid, const Halo& halo, const std::vector<std::string>& species,
+               const TermList& terms, const OperatorMatrices* ops,
+               const std::vector<FaceValues>* dirichlet, double dt);
   TsIntegrator(const TsIntegrator&) = delete;
   TsIntegrator& operator=(const TsIntegrator&) = delete;
 
   // Advance the ghosted local state vectors (owned cells) from t to t + dt (TS may take
-  // several internal steps when adaptive), then apply the clamp floor. `step` is for messages.
-  void step(std::vector<VecH>& u, double t, double dt, PetscInt step);
+  // several internal steps when adaptive), then apply the constraints. `step` is for messages.
+  void step(std::vector<VecH>& u, double t, double dt, PetscInt step) override;
 
   PetscInt total_steps() const { return steps_; }       // accepted internal TS steps so far
   PetscInt total_rejected() const { return rejected_; } // rejected internal TS steps so far
   bool adaptive() const { return adaptive_; }
+  bool implicit_diffusion() const { return ops_ != nullptr; }
   TS ts() const { return ts_.get(); }
+  DM dm() const { return dm_.get(); }
 
 private:
   static PetscErrorCode ifunction_cb(TS, PetscReal t, Vec X, Vec Xdot, Vec F, void* ctx);
@@ -80,36 +87,40 @@ private:
                                      Mat P, void* ctx);
   PetscErrorCode ifunction(Vec X, Vec Xdot, Vec F);
   PetscErrorCode rhsfunction(PetscReal t, Vec X, Vec G);
+  void add_rhs_terms(const PetscScalar* xl, double t, PetscScalar* g) const;
   PetscErrorCode ijacobian(PetscReal shift, Mat A, Mat P);
   PetscErrorCode fill_jacobian(PetscReal shift);
 
   void build_operator();
   void setup_ts(double dt);
+  void setup_implicit_solver(double dt);
+  void check_type();
   // Owned cells between the ghosted local state and X; into X it returns whether any value
   // differed from X's (this rank).
   bool copy_state(std::vector<VecH>& u, bool to_x);
 
   const Grid& grid_;
-  RatesFn rates_;
+  const Halo& halo_;
   std::vector<std::string> species_;
-  const ParamSet& params_;
-  std::vector<double> floor_;
-  const OperatorMatrices& ops_;
-  SourceTerms* sources_;
+  const TermList& terms_;
+  const OperatorMatrices* ops_;
+  const std::vector<FaceValues>* dirichlet_;
+  std::vector<const Term*> rhs_; // the terms of G
+  HaloNeed rhs_halo_;
   PetscInt ns_ = 0, nloc_ = 0;
 
-  VecH X_, bD_;              // block state; block D_s b_s (Dirichlet data)
+  DMH dm_;                   // DMDA with one dof per species
+  VecH X_, bD_;              // state; interlaced scale_s b_s (Dirichlet data)
   bool has_b_ = false;       // any Dirichlet data at all
-  MatH Dblock_;              // blockdiag(scale_s M_s)
-  MatH J_;                   // shift I - Dblock
+  MatH Dblock_;              // K without b
+  MatH J_;                   // shift I - K
   PetscReal jac_shift_ = -1; // shift J_ holds (-1: stale)
-  TSH ts_;                   // destroyed before the matrices it uses
+  TSH ts_;                   // destroyed before the matrices and DM it uses
   bool adaptive_ = false;
   double next_dt_ = 0; // the adaptive controller's proposal for the next internal step
   bool solved_ = false;
 
   std::exception_ptr callback_error_;
-  std::vector<double> cell_u_, cell_p_, cell_r_;
   PetscInt steps_ = 0, rejected_ = 0;
 };
 

@@ -73,18 +73,17 @@ void on_read(png_structp png, png_bytep data, png_size_t length) {
   }
 }
 
-// Writes the whole 8-bit RGB image; row 0 of rgb is the top row. False on a libpng error.
-bool png_write_all(png_structp png, png_infop info, PngIo* io, int width, int height,
-                   const unsigned char* rgb) {
+// Writes the whole image (rows of `stride` bytes, row 0 the top row) with the given bit depth
+// and colour type. False on a libpng error.
+bool png_write_all(png_structp png, png_infop info, PngIo* io, int width, int height, int depth,
+                   int colour, std::size_t stride, const unsigned char* pixels) {
   if (setjmp(png_jmpbuf(png))) return false;
   png_set_write_fn(png, io, on_write, on_flush);
-  png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8,
-               PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
-               PNG_FILTER_TYPE_DEFAULT);
+  png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), depth,
+               colour, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   png_write_info(png, info);
-  const std::size_t stride = static_cast<std::size_t>(width) * 3;
   for (int r = 0; r < height; ++r)
-    png_write_row(png, rgb + stride * static_cast<std::size_t>(r));
+    png_write_row(png, pixels + stride * static_cast<std::size_t>(r));
   png_write_end(png, nullptr);
   return true;
 }
@@ -149,13 +148,13 @@ struct ReadStructs {
   }
 };
 
-} // namespace
-
-void write_png_rgb(const std::string& path, int width, int height, const unsigned char* rgb) {
+// Writes a PNG of any layout to path + ".tmp" and renames it onto path (see the header).
+void write_png_pixels(const std::string& path, int width, int height, int depth, int colour,
+                      std::size_t stride, const unsigned char* pixels) {
   if (width <= 0 || height <= 0)
     throw UserError(write_failure(path, "invalid image size " + std::to_string(width) + "x" +
                                             std::to_string(height)));
-  if (rgb == nullptr) throw UserError(write_failure(path, "no pixel data"));
+  if (pixels == nullptr) throw UserError(write_failure(path, "no pixel data"));
 
   const std::string tmp = path + ".tmp";
   std::FILE* fp = std::fopen(tmp.c_str(), "wb");
@@ -168,7 +167,7 @@ void write_png_rgb(const std::string& path, int width, int height, const unsigne
   png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
   if (png == nullptr || info == nullptr)
     reason = "cannot initialise libpng (out of memory)";
-  else if (!png_write_all(png, info, &io, width, height, rgb))
+  else if (!png_write_all(png, info, &io, width, height, depth, colour, stride, pixels))
     reason = io.msg[0] != '\0' ? io.msg : "libpng error";
   if (png != nullptr) png_destroy_write_struct(&png, info != nullptr ? &info : nullptr);
 
@@ -183,27 +182,173 @@ void write_png_rgb(const std::string& path, int width, int height, const unsigne
   }
 }
 
+// A 5x7 bitmap font for the colour-bar labels: rows top to bottom, bit 4 the left column.
+struct Glyph {
+  char c;
+  unsigned char rows[7];
+};
+constexpr Glyph kFont[] = {
+    {'0', {0x0E, 0x11, 0x13, 0x15, 0x19, 0x11, 0x0E}},
+    {'1', {0x04, 0x0C, 0x04, 0x04, 0x04, 0x04, 0x0E}},
+    {'2', {0x0E, 0x11, 0x01, 0x02, 0x04, 0x08, 0x1F}},
+    {'3', {0x1F, 0x02, 0x04, 0x02, 0x01, 0x11, 0x0E}},
+    {'4', {0x02, 0x06, 0x0A, 0x12, 0x1F, 0x02, 0x02}},
+    {'5', {0x1F, 0x10, 0x1E, 0x01, 0x01, 0x11, 0x0E}},
+    {'6', {0x06, 0x08, 0x10, 0x1E, 0x11, 0x11, 0x0E}},
+    {'7', {0x1F, 0x01, 0x02, 0x04, 0x08, 0x08, 0x08}},
+    {'8', {0x0E, 0x11, 0x11, 0x0E, 0x11, 0x11, 0x0E}},
+    {'9', {0x0E, 0x11, 0x11, 0x0F, 0x01, 0x02, 0x0C}},
+    {'.', {0, 0, 0, 0, 0, 0x0C, 0x0C}},
+    {'-', {0, 0, 0, 0x1F, 0, 0, 0}},
+    {'+', {0, 0x04, 0x04, 0x1F, 0x04, 0x04, 0}},
+    {'e', {0, 0, 0x0E, 0x11, 0x1F, 0x10, 0x0E}},
+    {'n', {0, 0, 0x16, 0x19, 0x11, 0x11, 0x11}},
+    {'a', {0, 0, 0x0E, 0x01, 0x0F, 0x11, 0x0F}},
+    {'i', {0x04, 0, 0x0C, 0x04, 0x04, 0x04, 0x0E}},
+    {'f', {0x06, 0x09, 0x08, 0x1C, 0x08, 0x08, 0x08}},
+};
+
+// An RGB canvas, row 0 the top row.
+struct Canvas {
+  int width = 0, height = 0;
+  std::vector<unsigned char> rgb;
+  unsigned char* at(int x, int y) {
+    return rgb.data() + 3 * (static_cast<std::size_t>(y) * width + static_cast<std::size_t>(x));
+  }
+};
+
+// Draws `text` in black with its top-left corner at (x, y), each font pixel f x f.
+void draw_text(Canvas& c, int x, int y, const std::string& text, int f) {
+  for (char ch : text) {
+    for (const Glyph& g : kFont) {
+      if (g.c != ch) continue;
+      for (int r = 0; r < 7; ++r)
+        for (int b = 0; b < 5; ++b)
+          if ((g.rows[r] >> (4 - b)) & 1)
+            for (int dy = 0; dy < f; ++dy)
+              for (int dx = 0; dx < f; ++dx) {
+                const int px = x + b * f + dx, py = y + r * f + dy;
+                if (px >= 0 && px < c.width && py >= 0 && py < c.height) {
+                  unsigned char* p = c.at(px, py);
+                  p[0] = p[1] = p[2] = 0;
+                }
+              }
+    }
+    x += 6 * f;
+  }
+}
+
+// Maps a field value to t in [0, 1] (NaN stays NaN); see write_field_png.
+struct RangeMap {
+  double lo, scale;
+  bool degenerate;
+  RangeMap(double lo_, double hi_) : lo(lo_), scale(0), degenerate(!(hi_ > lo_)) {
+    if (!degenerate) scale = 1.0 / (hi_ - lo_);
+  }
+  double operator()(double v) const {
+    return std::isnan(v) ? v : degenerate ? 0.5 : (v - lo) * scale;
+  }
+};
+
+// The field upscaled into the top-left of a white canvas, with the colour bar if asked for.
+Canvas field_canvas(int nx, int ny, const double* field, double lo, double hi,
+                    const FieldImageStyle& st) {
+  const int w = nx * st.scale, h = ny * st.scale;
+  const int f = std::clamp(h / 128, 1, 8); // font pixel size
+  std::vector<std::string> labels;
+  int bar_x = w, label_x = w;
+  Canvas c;
+  c.width = w;
+  c.height = h;
+  if (st.colorbar) {
+    labels = colorbar_labels(lo, hi);
+    std::size_t chars = 0;
+    for (const auto& l : labels)
+      chars = std::max(chars, l.size());
+    const int gap = 4 * f, bar_w = std::max(8 * f, h / 16);
+    bar_x = w + gap;
+    label_x = bar_x + bar_w + gap;
+    c.width = label_x + static_cast<int>(chars) * 6 * f + gap;
+    c.height = std::max(h, 2 * 7 * f + 2 * f);
+  }
+  c.rgb.assign(static_cast<std::size_t>(c.width) * c.height * 3, 255);
+  const RangeMap map(lo, hi);
+  for (int y = 0; y < h; ++y) {
+    const double* src = field + static_cast<std::size_t>(nx) * (ny - 1 - y / st.scale);
+    for (int x = 0; x < w; ++x)
+      colormap_rgb(st.colormap, map(src[x / st.scale]), c.at(x, y));
+  }
+  if (!st.colorbar) return c;
+  for (int y = 0; y < h; ++y) {
+    const double t = h > 1 ? 1.0 - static_cast<double>(y) / (h - 1) : 0.5;
+    for (int x = bar_x; x < label_x - 4 * f; ++x)
+      colormap_rgb(st.colormap, t, c.at(x, y));
+  }
+  draw_text(c, label_x, 0, labels[2], f);                          // hi at the top
+  draw_text(c, label_x, std::max(h, 7 * f) - 7 * f, labels[0], f); // lo at the bottom
+  if (h >= 4 * 7 * f) draw_text(c, label_x, h / 2 - 7 * f / 2, labels[1], f);
+  return c;
+}
+
+} // namespace
+
+void write_png_rgb(const std::string& path, int width, int height, const unsigned char* rgb) {
+  write_png_pixels(path, width, height, 8, PNG_COLOR_TYPE_RGB,
+                   static_cast<std::size_t>(std::max(width, 0)) * 3, rgb);
+}
+
+void write_png_grey16(const std::string& path, int width, int height, const unsigned short* grey) {
+  if (grey == nullptr || width <= 0 || height <= 0) {
+    write_png_pixels(path, width, height, 16, PNG_COLOR_TYPE_GRAY, 0, nullptr);
+    return;
+  }
+  const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  std::vector<unsigned char> be(2 * n); // PNG stores 16-bit samples big-endian
+  for (std::size_t i = 0; i < n; ++i) {
+    be[2 * i] = static_cast<unsigned char>(grey[i] >> 8);
+    be[2 * i + 1] = static_cast<unsigned char>(grey[i] & 0xFF);
+  }
+  write_png_pixels(path, width, height, 16, PNG_COLOR_TYPE_GRAY,
+                   2 * static_cast<std::size_t>(width), be.data());
+}
+
+std::vector<std::string> colorbar_labels(double lo, double hi) {
+  std::vector<std::string> out;
+  for (double v : {lo, 0.5 * (lo + hi), hi}) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g", v);
+    out.emplace_back(buf);
+  }
+  return out;
+}
+
 void write_field_png(const std::string& path, int nx, int ny, const double* field, double lo,
-                     double hi) {
+                     double hi, const FieldImageStyle& style) {
   if (nx <= 0 || ny <= 0)
     throw UserError(
         write_failure(path, "invalid image size " + std::to_string(nx) + "x" + std::to_string(ny)));
   if (field == nullptr) throw UserError(write_failure(path, "no field data"));
-  const bool degenerate = !(hi > lo); // also true when a bound is NaN
-  const double scale = degenerate ? 0.0 : 1.0 / (hi - lo);
-  const std::size_t w = static_cast<std::size_t>(nx);
-  std::vector<unsigned char> rgb(w * static_cast<std::size_t>(ny) * 3);
-  for (int r = 0; r < ny; ++r) {
-    const std::size_t j = static_cast<std::size_t>(ny - 1 - r); // image top row = largest j
-    const double* src = field + w * j;
-    unsigned char* dst = rgb.data() + w * 3 * static_cast<std::size_t>(r);
-    for (std::size_t i = 0; i < w; ++i) {
-      const double v = src[i];
-      const double t = std::isnan(v) ? v : degenerate ? 0.5 : (v - lo) * scale;
-      viridis(t, dst + 3 * i);
+  if (style.scale < 1 || style.scale > 64 || (style.bits != 8 && style.bits != 16))
+    throw UserError(write_failure(path, "invalid style (scale " + std::to_string(style.scale) +
+                                            ", bits " + std::to_string(style.bits) + ")"));
+  if (style.bits == 16) {
+    const int w = nx * style.scale, h = ny * style.scale;
+    const RangeMap map(lo, hi);
+    std::vector<unsigned short> grey(static_cast<std::size_t>(w) * h);
+    for (int y = 0; y < h; ++y) {
+      const double* src = field + static_cast<std::size_t>(nx) * (ny - 1 - y / style.scale);
+      for (int x = 0; x < w; ++x) {
+        const double t = map(src[x / style.scale]);
+        const double c = std::isnan(t) ? 0.0 : std::clamp(t, 0.0, 1.0);
+        grey[static_cast<std::size_t>(y) * w + x] =
+            static_cast<unsigned short>(std::lround(c * 65535.0));
+      }
     }
+    write_png_grey16(path, w, h, grey.data());
+    return;
   }
-  write_png_rgb(path, nx, ny, rgb.data());
+  const Canvas c = field_canvas(nx, ny, field, lo, hi, style);
+  write_png_rgb(path, c.width, c.height, c.rgb.data());
 }
 
 GreyImage read_png_grey(const std::string& path) {

@@ -10,6 +10,8 @@
 // failed write never leaves a partial file at `path` (the .tmp file is removed).
 #pragma once
 
+#include "io/colormap.hpp"
+
 #include <string>
 #include <vector>
 
@@ -18,11 +20,25 @@ namespace morphogen::io {
 // Write an 8-bit RGB PNG. rgb holds width*height*3 bytes, row-major, row 0 = top row.
 void write_png_rgb(const std::string& path, int width, int height, const unsigned char* rgb);
 
-// Write a scalar field as a viridis-coloured PNG. field[i + nx*j], j = 0 is the bottom row.
-// Each value maps to t = (v-lo)/(hi-lo) (clamped to [0,1] by the colour map); if hi <= lo
-// (or either bound is NaN) every finite value maps to t = 0.5. NaN values appear magenta.
+// Write a 16-bit greyscale PNG. grey holds width*height samples, row-major, row 0 = top row.
+void write_png_grey16(const std::string& path, int width, int height, const unsigned short* grey);
+
+// How write_field_png draws a field.
+struct FieldImageStyle {
+  Colormap colormap = Colormap::viridis;
+  int scale = 1;         // each cell becomes scale x scale pixels (nearest neighbour), 1..64
+  bool colorbar = false; // a vertical colour bar with the lo, middle and hi values on the right
+  int bits = 8;          // 8: RGB through the colour map; 16: 16-bit grey (no map, no bar)
+};
+
+// Write a scalar field as a PNG. field[i + nx*j], j = 0 is the bottom row. Each value maps to
+// t = (v-lo)/(hi-lo) (clamped to [0,1]); if hi <= lo (or either bound is NaN) every finite value
+// maps to t = 0.5. NaN values appear magenta (8-bit) or black (16-bit grey).
 void write_field_png(const std::string& path, int nx, int ny, const double* field, double lo,
-                     double hi);
+                     double hi, const FieldImageStyle& style = {});
+
+// The colour-bar labels of a range: lo, the middle and hi, each printed with %.3g.
+std::vector<std::string> colorbar_labels(double lo, double hi);
 
 // A greyscale image with values in [0, 1]; value[i + width*j], j = 0 is the BOTTOM row.
 struct GreyImage {

@@ -36,6 +36,7 @@ public:
   DiffusionOperator(const Grid& grid, const Halo& halo, DiffusionScheme scheme,
                     std::vector<std::vector<double>> coef);
 
+  const Grid& grid() const { return grid_; }
   DiffusionScheme scheme() const { return scheme_; }
   bool constant() const { return scheme_ == DiffusionScheme::Constant; }
   double D() const { return D_; } // Constant only

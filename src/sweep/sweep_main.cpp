@@ -2,6 +2,7 @@
 
 #include "analysis/linear_stability.hpp"
 #include "app/deck.hpp"
+#include "app/help.hpp"
 #include "app/simulation.hpp"
 #include "core/collective_error.hpp"
 #include "core/user_error.hpp"
@@ -91,7 +92,7 @@ Setup read_setup(Options& opt, const std::string& base_dir) {
 
 // Every rank, on PETSC_COMM_SELF: build the simulation of every axis value (others at their
 // first value) so a bad value fails before anything runs. Returns the first point's options.
-std::string validate(const Setup& s, std::string& dir) {
+std::string validate(const Setup& s, const Options& sopt, std::string& dir) {
   std::string yaml;
   const size_t na = s.spec.axes.size();
   for (size_t a = 0; a < na; ++a)
@@ -112,10 +113,17 @@ std::string validate(const Setup& s, std::string& dir) {
                           sim.model().name);
       }
       if (a == 0 && v == 0) {
+        const std::string model = sim.model().name;
+        opt.set_unknown_hint(
+            [model](const std::string& name) { return other_model_hint(name, model); });
         opt.check_unused();
         dir = sim.output().dir;
         yaml = opt.to_yaml("");
-        if (opt.help_requested()) return yaml; // the options are listed once
+        if (opt.help_requested()) { // the options are listed once
+          print_options_help(PETSC_COMM_WORLD, {&sopt, &opt});
+          print_models_help(PETSC_COMM_WORLD);
+          return yaml;
+        }
       }
     }
   return yaml;
@@ -159,7 +167,7 @@ std::vector<long long> finished_points(const std::string& dir, const SweepSpec& 
 
 } // namespace
 
-int run_sweep(int* argc, char*** argv) {
+int run_sweep(int* argc, char*** argv, const std::vector<OptionsFileArg>& options_files) {
   const double wall_start = MPI_Wtime();
   MPI_Comm world = PETSC_COMM_WORLD;
   int rank = 0;
@@ -170,11 +178,17 @@ int run_sweep(int* argc, char*** argv) {
   --*argc;
   if (*argc < 2 || (*argv)[1][0] == '-')
     throw UserError("sweep: needs a deck (morphogen sweep DECK.yaml [-option value ...])");
-  const std::string base_dir = load_deck(argc, argv);
+  const std::string deck = (*argv)[1];
+  const std::string base_dir = load_deck(argc, argv, options_files);
   Options sopt(world);
+  if (!sopt.is_set("sweep_axes"))
+    throw UserError("deck " + deck +
+                    ": no sweep: section (sweep: {axes: [params_F, ...], params_F: "
+                    "linspace(a, b, n), ...}); to run it once: morphogen " +
+                    deck);
   Setup s = read_setup(sopt, base_dir);
   std::string dir;
-  const std::string yaml = validate(s, dir);
+  const std::string yaml = validate(s, sopt, dir);
   if (sopt.help_requested()) return 0; // -help lists the options; it runs nothing
   s.set.dir = dir;
   const long long npoints = s.spec.points();

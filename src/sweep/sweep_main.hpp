@@ -9,9 +9,14 @@
 // SIGUSR1/SIGTERM: the running points are abandoned, the table written, exit code 3.
 #pragma once
 
+#include "app/deck.hpp"
+
+#include <vector>
+
 namespace morphogen::sweep {
 
-// Returns the exit code. argv[1] is "sweep" and argv[2] the deck.
-int run_sweep(int* argc, char*** argv);
+// Returns the exit code. argv[1] is "sweep" and argv[2] the deck (which must have a sweep:
+// section). options_files: -options_file arguments (app/command_line.hpp).
+int run_sweep(int* argc, char*** argv, const std::vector<OptionsFileArg>& options_files = {});
 
 } // namespace morphogen::sweep

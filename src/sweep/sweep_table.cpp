@@ -38,6 +38,16 @@ std::vector<double> refined(const std::vector<double>& v, int refine) {
   return out;
 }
 
+// Past the Hopf line: for two species trace J > 0 with det J > 0 (the edge of this region is the
+// Hopf line trace J = 0; the edge of the complex-eigenvalue region, trace^2 = 4 det, is not a
+// stability boundary); for other species counts, J has a complex pair with Re > 0.
+bool past_hopf(const analysis::StabilityResult& st) {
+  if (st.nspecies != 2 || st.jacobian.size() != 4) return st.hopf;
+  const auto& J = st.jacobian;
+  const double tr = J[0] + J[3], det = J[0] * J[3] - J[1] * J[2];
+  return tr > st.tol && det > 0;
+}
+
 // Linear stability over a refined grid of the axes (empty when an axis is not a model
 // parameter or diffusion coefficient, or a parameter varies in space).
 nlohmann::json stability_map(const SweepSpec& spec, const std::string& base_dir) {
@@ -80,7 +90,7 @@ nlohmann::json stability_map(const SweepSpec& spec, const std::string& base_dir)
   }
   if (total > 40000) return {};
   nlohmann::json turing = nlohmann::json::array(), hopf = nlohmann::json::array(),
-                 wl = nlohmann::json::array();
+                 hopf_region = nlohmann::json::array(), wl = nlohmann::json::array();
   for (size_t p = 0; p < total; ++p) {
     size_t r = p;
     for (size_t a = 0; a < axes.size(); ++a) {
@@ -91,16 +101,22 @@ nlohmann::json stability_map(const SweepSpec& spec, const std::string& base_dir)
       const auto st = analyse_states(m, params, D, so, nullptr);
       turing.push_back(st.turing_unstable);
       hopf.push_back(st.hopf);
+      hopf_region.push_back(past_hopf(st));
       wl.push_back(st.turing_unstable && std::isfinite(st.wavelength_fastest)
                        ? nlohmann::json(st.wavelength_fastest)
                        : nlohmann::json());
     } catch (const std::exception&) {
       turing.push_back(false);
       hopf.push_back(false);
+      hopf_region.push_back(false);
       wl.push_back(nullptr);
     }
   }
-  return {{"axes", axes}, {"turing", turing}, {"hopf", hopf}, {"wavelength", wl}};
+  return {{"axes", axes},
+          {"turing", turing},
+          {"hopf", hopf},
+          {"hopf_region", hopf_region},
+          {"wavelength", wl}};
 }
 
 } // namespace

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -234,4 +236,96 @@ TEST(SampleBilinear, SinglePixelAndEmpty) {
   one.value = {0.7};
   EXPECT_DOUBLE_EQ(sample_bilinear(one, 0.3, 0.9), 0.7);
   EXPECT_THROW(sample_bilinear(GreyImage{}, 0.5, 0.5), std::invalid_argument);
+}
+
+TEST(Colormap, NamedMapsAndEndpoints) {
+  EXPECT_EQ(colormap_names(), (std::vector<std::string>{"grey", "viridis", "magma", "coolwarm"}));
+  EXPECT_EQ(colormap_from_name("magma"), Colormap::magma);
+  EXPECT_FALSE(colormap_from_name("jet").has_value());
+  unsigned char c[3];
+  colormap_rgb(Colormap::magma, 0.0, c);
+  EXPECT_EQ((std::array<int, 3>{c[0], c[1], c[2]}), (std::array<int, 3>{0, 0, 4}));
+  colormap_rgb(Colormap::magma, 1.0, c);
+  EXPECT_EQ((std::array<int, 3>{c[0], c[1], c[2]}), (std::array<int, 3>{252, 253, 191}));
+  colormap_rgb(Colormap::coolwarm, 0.0, c); // diverging: blue, light grey, red
+  EXPECT_GT(c[2], c[0]);
+  colormap_rgb(Colormap::coolwarm, 1.0, c);
+  EXPECT_GT(c[0], c[2]);
+  colormap_rgb(Colormap::coolwarm, 0.5, c);
+  EXPECT_NEAR(c[0], c[2], 2);
+  colormap_rgb(Colormap::grey, 0.5, c);
+  EXPECT_EQ((std::array<int, 3>{c[0], c[1], c[2]}), (std::array<int, 3>{128, 128, 128}));
+  colormap_rgb(Colormap::grey, std::nan(""), c);
+  EXPECT_EQ((std::array<int, 3>{c[0], c[1], c[2]}), (std::array<int, 3>{255, 0, 255}));
+}
+
+TEST_F(PngFileTest, ScaleRepeatsEachCell) {
+  const std::vector<double> f{0.0, 1.0, 2.0, 3.0, 4.0, 5.0}; // 3 x 2, j = 0 the bottom row
+  FieldImageStyle st;
+  st.colormap = Colormap::grey;
+  st.scale = 3;
+  write_field_png(file("s.png"), 3, 2, f.data(), 0.0, 5.0, st);
+  const GreyImage img = read_png_grey(file("s.png"));
+  ASSERT_EQ(img.width, 9);
+  ASSERT_EQ(img.height, 6);
+  for (int j = 0; j < 6; ++j)
+    for (int i = 0; i < 9; ++i)
+      EXPECT_NEAR(img.value[i + 9 * j], std::lround(f[i / 3 + 3 * (j / 3)] / 5.0 * 255) / 255.0,
+                  1e-12)
+          << i << "," << j;
+}
+
+TEST_F(PngFileTest, Grey16KeepsSixteenBits) {
+  std::vector<double> f(40);
+  for (size_t k = 0; k < f.size(); ++k)
+    f[k] = 0.001 * static_cast<double>(k * k);
+  FieldImageStyle st;
+  st.bits = 16;
+  const double lo = 0.0, hi = f.back();
+  write_field_png(file("g.png"), 8, 5, f.data(), lo, hi, st);
+  const GreyImage img = read_png_grey(file("g.png"));
+  ASSERT_EQ(img.width, 8);
+  for (size_t k = 0; k < f.size(); ++k)
+    EXPECT_NEAR(img.value[k], (f[k] - lo) / (hi - lo), 0.5 / 65535 + 1e-12) << k;
+  std::ifstream in(file("g.png"), std::ios::binary);
+  char head[26];
+  in.read(head, 26);
+  EXPECT_EQ(head[24], 16); // bit depth
+  EXPECT_EQ(head[25], 0);  // grey
+}
+
+TEST_F(PngFileTest, ColorbarBesideTheField) {
+  std::vector<double> f(16 * 64);
+  for (size_t k = 0; k < f.size(); ++k)
+    f[k] = static_cast<double>(k % 16);
+  FieldImageStyle st;
+  st.colorbar = true;
+  st.scale = 2;
+  write_field_png(file("c.png"), 16, 64, f.data(), 0.0, 15.0, st);
+  const GreyImage img = read_png_grey(file("c.png"));
+  EXPECT_EQ(img.height, 128);
+  ASSERT_GT(img.width, 32 + 20);
+  // the bar (a few pixels right of the field) runs from viridis(0) at the bottom to viridis(1)
+  unsigned char lo[3], hi[3];
+  viridis(0.0, lo);
+  viridis(1.0, hi);
+  const int x = 32 + 4 + 2; // field, gap (4 font pixels of 1), inside the bar
+  EXPECT_NEAR(img.value[x], luminance(lo), 1e-9);
+  EXPECT_NEAR(img.value[x + img.width * 127], luminance(hi), 1e-9);
+  EXPECT_EQ(colorbar_labels(0.0, 15.0), (std::vector<std::string>{"0", "7.5", "15"}));
+  // the labels are drawn in black right of the bar
+  double darkest = 1.0;
+  for (int j = 0; j < img.height; ++j)
+    for (int i = x + 10; i < img.width; ++i)
+      darkest = std::min(darkest, img.value[i + img.width * j]);
+  EXPECT_EQ(darkest, 0.0);
+}
+
+TEST_F(PngFileTest, BadStyleIsAUserError) {
+  const std::vector<double> f(4, 1.0);
+  FieldImageStyle st;
+  st.scale = 0;
+  expect_user_error_naming([&] { write_field_png(file("b.png"), 2, 2, f.data(), 0, 1, st); },
+                           "scale 0");
+  EXPECT_FALSE(fs::exists(file("b.png")));
 }

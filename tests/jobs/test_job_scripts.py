@@ -31,6 +31,7 @@ state=$FAKE_STATE
 n=$(( $(cat "$state/launch.count" 2>/dev/null || echo 0) + 1 ))
 echo "$n" > "$state/launch.count"
 printf '%s\n' "$@" > "$state/launch.args.$n"
+printf '%s\n' "${HWLOC_COMPONENTS-unset}" "${OMPI_MCA_odls_base_sigkill_timeout-unset}" > "$state/launch.env.$n"
 read -r -a codes <<< "${FAKE_EXIT_CODES:-0}"
 code=${codes[n-1]:-${codes[-1]}}
 out=""; prev=""
@@ -46,11 +47,16 @@ IFS=';' read -r -a points <<< "${FAKE_POINTS:-}"
 for p in ${points[n-1]:-}; do
   mkdir -p "$out/points" && : > "$out/points/$(printf 'point_%06d.json' "$p")"
 done
-if [[ $code == 3 && ${FAKE_CHECKPOINT:-1} == 1 && -n $out ]]; then
+if [[ ($code == 3 || ${FAKE_RANKS_EXIT:-} == 3) && ${FAKE_CHECKPOINT:-1} == 1 && -n $out ]]; then
   : > "$out/$(printf 'checkpoint_%07d.vtkhdf' $((n * 100)))"
 fi
+# The ranks' own exit code (rank 0 writes it to MORPHOGEN_EXIT_FILE), when it is not the launcher's.
+if [[ -n ${FAKE_RANKS_EXIT:-} && -n ${MORPHOGEN_EXIT_FILE:-} ]]; then echo "$FAKE_RANKS_EXIT" > "$MORPHOGEN_EXIT_FILE"; fi
 exit "$code"
 """
+
+# With FAKE_RANKS_EXIT the ranks' exit code is written to $MORPHOGEN_EXIT_FILE, as morphogen's
+# rank 0 does (cli/exit_file.hpp), while the launcher exits with FAKE_EXIT_CODES.
 
 # Fake sbatch / qsub: records arguments, environment and working directory of each submission.
 FAKE_SUBMIT = r"""#!/bin/bash
@@ -793,3 +799,70 @@ def test_real_sweep_signal_resubmit_resume(cluster):
     assert cluster.count("submit") == 1
     log = cluster.history()
     assert "starts from 1 finished points" in log and "run finished (exit 0)" in log
+
+
+# ---------------------------------------------------------------------------------------------
+# The exit code as seen through the launcher, and the launcher's environment
+
+
+@pytest.mark.parametrize("script,env_of", [("run.sbatch", "slurm_env"), ("run.pbs", "pbs_env")])
+def test_ranks_exit_code_wins_over_the_launchers(cluster, script, env_of):
+    """Open MPI's mpiexec returns 1 when SIGTERM reached it although the ranks checkpointed and
+    exited 3: the exit code the ranks wrote (MORPHOGEN_EXIT_FILE) decides, so the job resubmits."""
+    env = getattr(cluster, env_of)(FAKE_EXIT_CODES="1", FAKE_RANKS_EXIT="3")
+    res = cluster.run(script, env)
+    assert res.returncode == 0, res.stderr  # exit 3 with a new checkpoint: resubmitted
+    assert cluster.count("submit") == 1
+    assert "the launcher returned 1, the ranks exited with 3: using 3" in res.stderr
+    assert not os.path.exists(os.path.join(cluster.out, ".morphogen_exit_code"))
+
+
+def test_no_exit_file_keeps_the_launchers_code(cluster):
+    """An aborted run writes no exit file: the launcher's code stands (and a stale file from an
+    earlier segment is removed before the launch)."""
+    os.makedirs(cluster.out)
+    with open(os.path.join(cluster.out, ".morphogen_exit_code"), "w") as f:
+        f.write("3\n")
+    res = cluster.run("run.sbatch", cluster.slurm_env(FAKE_EXIT_CODES="4"))
+    assert res.returncode == 4, res.stderr
+    assert cluster.count("submit") == 0
+
+
+def test_launcher_environment_keeps_signals_deliverable(cluster):
+    """hwloc's OpenCL/GL plugins are off (an OpenCL ICD's LLVM would take SIGUSR1 from mpiexec),
+    mpiexec gives the ranks time to checkpoint on SIGTERM; a user's own settings are kept."""
+    cluster.run("run.pbs", cluster.pbs_env())
+    assert (cluster.state / "launch.env.1").read_text().split() == ["-opencl,-gl", "30"]
+    cluster.run("run.pbs", cluster.pbs_env(HWLOC_COMPONENTS="-cuda", OMPI_MCA_odls_base_sigkill_timeout="5"))
+    assert (cluster.state / "launch.env.2").read_text().split() == ["-cuda", "5"]
+
+
+def test_real_mpiexec_sigterm_exit_code_through_the_job(cluster):
+    """The batch system's SIGTERM to the whole job (shell, mpiexec and ranks): the ranks
+    checkpoint and exit 3, mpiexec returns its own code, the job reads the ranks' code and (with
+    MORPHOGEN_RESUBMIT_ON_TERM=1) resubmits; the checkpoint is complete."""
+    out = cluster.out
+    env = cluster.pbs_env(
+        MORPHOGEN=EXE, MORPHOGEN_LAUNCHER=f"{MPIEXEC} --oversubscribe -n 2", MORPHOGEN_RESUBMIT_ON_TERM="1",
+        OMPI_MCA_odls_base_sigkill_timeout="10",
+        EXTRA_ARGS="-grid_n 32,32 -steps 10000000 -png_every 0 -progress_every 1000000",
+        OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_rmaps_base_oversubscribe="1")
+    proc = subprocess.Popen(["bash", os.path.join(JOBS, "run.pbs")], env=env, cwd=cluster.tmp,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        deadline = time.monotonic() + 60
+        while not os.path.exists(os.path.join(out, "options_used.yaml.tmp")) and \
+                not os.path.exists(os.path.join(out, "options_used.yaml")):
+            assert proc.poll() is None, proc.communicate()
+            assert time.monotonic() < deadline, "the run did not start"
+            time.sleep(0.05)
+        time.sleep(1.0)
+        os.killpg(proc.pid, signal.SIGTERM)  # every process of the job, as qdel / a preemption does
+        stdout, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+    assert proc.returncode == 0, stdout + err  # resubmitted
+    assert cluster.count("submit") == 1, err
+    checkpoints = glob.glob(os.path.join(out, "checkpoint_*.vtkhdf"))
+    assert len(checkpoints) == 1 and not glob.glob(os.path.join(out, "*.tmp")), os.listdir(out)

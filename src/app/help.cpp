@@ -1,0 +1,147 @@
+#include "app/help.hpp"
+
+#include "app/model_registry.hpp"
+
+#include <map>
+#include <string>
+
+namespace morphogen {
+
+namespace {
+
+bool starts_with(const std::string& s, const std::string& p) {
+  return s.compare(0, p.size(), p) == 0;
+}
+
+// Topics, in the order listed, with the name prefixes of their options.
+const std::vector<std::pair<const char*, std::vector<const char*>>>& topics() {
+  static const std::vector<std::pair<const char*, std::vector<const char*>>> groups = {
+      {"Model and values",
+       {"model", "params_", "D_", "init_", "dirichlet_", "source_", "clamp", "seed"}},
+      {"Grid", {"grid_", "stencil", "sequence_"}},
+      {"Diffusion", {"diffusion", "tensor_", "surface_"}},
+      {"Time integration", {"integrator", "dt", "force_dt", "steps", "split_", "ts_"}},
+      {"Checkpoints and restart", {"checkpoint_", "restart", "max_walltime"}},
+      {"Output",
+       {"output_", "png_", "snapshot_", "summary", "progress_every", "nan_check_every", "movie_"}},
+      {"Sweep", {"sweep_"}},
+      {"Other", {""}},
+  };
+  return groups;
+}
+
+// Topic of an option, by its name.
+const char* group_of(const std::string& n) {
+  for (const auto& [group, prefixes] : topics())
+    for (const char* p : prefixes)
+      if (starts_with(n, p)) return group;
+  return "Other";
+}
+
+// Options read only in some configurations, in generic form: listed when this configuration
+// read none of them. {prefix that marks them as read, usage, help}.
+struct Conditional {
+  const char *read_prefix, *usage, *help;
+};
+const Conditional kConditional[] = {
+    {"source_", "-source_<species> VALUE",
+     "source term added to the species' reaction rate; may use t (default: none)"},
+    {"dirichlet_", "-dirichlet_<species> VALUE",
+     "boundary value on Dirichlet faces, an expression of the face position (default: the "
+     "species' initial value; with -grid_bc dirichlet)"},
+    {"png_range_", "-png_range_<species> LO,HI",
+     "fixed colour range of the species' images (default: from the data)"},
+    {"diffusion_", "-diffusion_<species> iso|tensor",
+     "diffusion of one species (default: -diffusion)"},
+    {"tensor_", "-tensor_<name>, -tensor_<species>_<name>",
+     "diffusion tensor (theta, l1, l2[, phi, l3] or xx, xy, yy[, xz, yz, zz]; with -diffusion "
+     "tensor)"},
+    {"split_", "-split_ordering lie|strang",
+     "operator splitting order (default strang; with -integrator split)"},
+    {"split_", "-split_reaction euler|heun|backward_euler|trapezoidal",
+     "reaction substep (default trapezoidal with strang, backward_euler with lie)"},
+    {"split_", "-split_diffusion backward_euler|crank_nicolson",
+     "diffusion substep (default crank_nicolson with strang, backward_euler with lie)"},
+    {"split_", "-split_newton_tol X, -split_newton_max_it N",
+     "per-cell Newton tolerance (default 1e-12, allowed [1e-16, 0.01]) and iteration cap "
+     "(default 20, allowed [1, 1000])"},
+    {"sequence_steps", "-sequence_steps N1,...",
+     "steps on each coarse level, coarsest first (with -sequence_levels L > 1: L-1 values)"},
+    {"", "-diffusion_ksp_*, -diffusion_pc_*",
+     "PETSc KSP/PC options of the diffusion solves (split and ts integrators; see -help petsc)"},
+    {"", "-ts_*, -snes_*, -ksp_*, -pc_*",
+     "PETSc TS options (with -integrator ts; see -help petsc)"},
+    {"", "-options_file FILE, -options_file_yaml FILE",
+     "more options from a file (after the deck, before the command line)"},
+    {"", "-help [petsc], -h, --help", "this listing; with petsc, PETSc's own options too"},
+    {"", "-version, --version", "morphogen's and PETSc's versions"},
+};
+
+} // namespace
+
+void print_options_help(MPI_Comm comm, const std::vector<const Options*>& opts) {
+  std::map<std::string, std::vector<const Options::Record*>> by_group;
+  std::map<std::string, bool> seen;
+  for (const Options* o : opts)
+    for (const auto& r : o->records()) {
+      if (seen[r.name]) continue;
+      seen[r.name] = true;
+      by_group[group_of(r.name)].push_back(&r);
+    }
+  PetscPrintf(comm,
+              "morphogen %s: morphogen [DECK.yaml] [-option value ...]\n"
+              "Options read by this configuration (-name <current value>: meaning):\n",
+              MORPHOGEN_VERSION);
+  for (const auto& [g, prefixes] : topics()) {
+    if (by_group[g].empty()) continue;
+    PetscPrintf(comm, "\n%s:\n", g);
+    for (const auto* r : by_group[g])
+      PetscPrintf(comm, "  -%s <%s>: %s\n", r->name.c_str(), r->value.c_str(), r->help.c_str());
+  }
+  PetscPrintf(comm, "\nOther options (read only in other configurations):\n");
+  for (const auto& c : kConditional) {
+    bool read = false;
+    for (const auto& [name, s] : seen)
+      read |= c.read_prefix[0] != '\0' && starts_with(name, c.read_prefix);
+    if (!read) PetscPrintf(comm, "  %s: %s\n", c.usage, c.help);
+  }
+}
+
+void print_models_help(MPI_Comm comm) {
+  PetscPrintf(comm, "\nModels (-model NAME):\n");
+  for (const auto& m : model_registry()) {
+    PetscPrintf(comm, "  %-18s %s (%s)\n", m.name, m.doc, m.reference);
+    for (int s = 0; s < m.nspecies; ++s)
+      PetscPrintf(comm, "      species %-6s D %-10s init %-10s %s\n", m.species[s].name,
+                  format_number(m.species[s].D).c_str(), format_number(m.species[s].init).c_str(),
+                  m.species[s].doc);
+    for (int q = 0; q < m.nparams; ++q)
+      PetscPrintf(comm, "      param   %-6s default %-10s %-22s %s\n", m.params[q].name,
+                  format_number(m.params[q].def).c_str(),
+                  allowed_range(m.params[q].lo, m.params[q].hi).c_str(), m.params[q].doc);
+  }
+}
+
+std::string other_model_hint(const std::string& option, const std::string& model) {
+  const auto us = option.find('_');
+  if (us == std::string::npos) return {};
+  const std::string kind = option.substr(0, us + 1), name = option.substr(us + 1);
+  std::string owners;
+  for (const auto& m : model_registry()) {
+    bool has = false;
+    if (kind == "params_")
+      for (int q = 0; q < m.nparams; ++q)
+        has |= name == m.params[q].name;
+    if (kind == "D_" || kind == "init_" || kind == "source_" || kind == "dirichlet_" ||
+        kind == "png_range_")
+      for (int s = 0; s < m.nspecies; ++s)
+        has |= name == m.species[s].name;
+    if (has && model != m.name) owners += (owners.empty() ? "" : ", ") + std::string(m.name);
+  }
+  if (owners.empty()) return {};
+  const std::string what = kind == "params_" ? "a parameter" : "a species";
+  return name + " is " + what + " of " + owners + ", not of " + model + " (-model " +
+         owners.substr(0, owners.find(',')) + ")";
+}
+
+} // namespace morphogen

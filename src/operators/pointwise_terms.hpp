@@ -1,0 +1,47 @@
+// Terms that read only their own cell (halo 0):
+//   ReactionTerm  R_s(u; p(x))      the model's kinetics, parameters scalar or per cell
+//   SourceTerm    S_s(x, t)         -source_<species> values (fields/source_terms.hpp)
+#pragma once
+
+#include "fields/param_set.hpp"
+#include "fields/source_terms.hpp"
+#include "operators/term.hpp"
+
+namespace morphogen {
+
+class ReactionTerm : public Term {
+public:
+  using RatesFn = void (*)(const double* u, const double* p, double* r);
+  // Keeps references to grid and params.
+  ReactionTerm(const Grid& grid, std::string model, RatesFn rates, int nspecies,
+               const ParamSet& params);
+
+  Kind kind() const override { return Kind::Reaction; }
+  std::string describe() const override { return "reaction (" + model_ + ")"; }
+  void add_rates(const StateArrays& state, double t, const RateArrays& rates) const override;
+
+private:
+  const Grid& grid_;
+  std::string model_;
+  RatesFn rates_;
+  int ns_;
+  const ParamSet& params_;
+};
+
+class SourceTerm : public Term {
+public:
+  // `sources` must outlive the term (its time-dependent values are cached there).
+  SourceTerm(const Grid& grid, SourceTerms& sources, std::vector<std::string> species);
+
+  Kind kind() const override { return Kind::Source; }
+  std::string describe() const override;
+  bool uses_time() const override { return true; }
+  void add_rates(const StateArrays& state, double t, const RateArrays& rates) const override;
+
+private:
+  const Grid& grid_;
+  SourceTerms& sources_;
+  std::vector<std::string> species_;
+};
+
+} // namespace morphogen
