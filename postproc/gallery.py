@@ -154,6 +154,18 @@ def make_one(deck, args, work):
 
 
 def write_index(rows, out):
+    """index.md over every deck made so far: the rows of earlier runs (OUT/index.json) updated
+    with these, so a run over some decks keeps the others' rows."""
+    path = os.path.join(out, "index.json")
+    known = {}
+    if os.path.isfile(path):
+        with open(path) as fh:
+            known = {r["deck"]: r for r in json.load(fh)}
+    for r in rows:
+        known[r["deck"]] = r
+    rows = [known[k] for k in sorted(known) if os.path.isfile(os.path.join(out, known[k]["image"]))]
+    with open(path, "w") as fh:
+        json.dump(rows, fh, indent=1)
     lines = ["| deck | reproduces | image |", "|---|---|---|"]
     for r in rows:
         what = f"{r['title']}: {r['source']}" if r["source"] else r["title"]

@@ -10,11 +10,16 @@
 #include <limits>
 #include <numbers>
 
+// LAPACK (Fortran): eigenvalues of a general real matrix.
+extern "C" void dgeev_(const char* jobvl, const char* jobvr, const int* n, double* a,
+                       const int* lda, double* wr, double* wi, double* vl, const int* ldvl,
+                       double* vr, const int* ldvr, double* work, const int* lwork, int* info);
+
 namespace morphogen::analysis {
 
 namespace {
 
-constexpr int kMaxSpecies = 4;
+constexpr int kMaxSpecies = 64;
 constexpr double kPi = std::numbers::pi;
 
 std::string fmt(const char* f, double v) {
@@ -253,78 +258,19 @@ bool eigenvalues(int n, const double* A, std::complex<double>* out, bool general
     }
     return true;
   }
-  // General path: the characteristic polynomial of A / ||A|| (Faddeev-LeVerrier), its roots
-  // by Aberth-Ehrlich iteration. Accuracy ~1e-15 ||A|| for simple roots, ~1e-8 ||A|| for
-  // double and ~1e-5 ||A|| for triple ones (polynomial roots are that ill-conditioned).
-  double scale = inf_norm(n, A);
-  if (!(scale > 0)) {
-    for (int i = 0; i < n; ++i)
-      out[i] = 0;
-    return true;
-  }
-  if (!std::isfinite(scale)) return false;
-  double B[kMaxSpecies * kMaxSpecies], M[kMaxSpecies * kMaxSpecies] = {},
-                                                       T[kMaxSpecies * kMaxSpecies];
+  // General path: LAPACK's dgeev (Hessenberg QR; eigenvalues only). The row-major A read as
+  // column-major is its transpose, which has the same eigenvalues.
   for (int i = 0; i < n * n; ++i)
-    B[i] = A[i] / scale;
-  double c[kMaxSpecies + 1]; // p(z) = sum_i c[i] z^i, c[n] = 1
-  c[n] = 1;
-  for (int k = 1; k <= n; ++k) {
-    // M <- B M + c[n-k+1] I ; c[n-k] = -tr(B M) / k
-    for (int i = 0; i < n; ++i)
-      for (int j = 0; j < n; ++j) {
-        double s = 0;
-        for (int l = 0; l < n; ++l)
-          s += B[i * n + l] * M[l * n + j];
-        T[i * n + j] = s + (i == j ? c[n - k + 1] : 0.0);
-      }
-    std::copy(T, T + n * n, M);
-    double tr = 0;
-    for (int i = 0; i < n; ++i)
-      for (int l = 0; l < n; ++l)
-        tr += B[i * n + l] * M[l * n + i];
-    c[n - k] = -tr / k;
-  }
-  auto eval = [&](std::complex<double> z, std::complex<double>& dp) {
-    std::complex<double> p = c[n];
-    dp = 0;
-    for (int i = n - 1; i >= 0; --i) {
-      dp = dp * z + p;
-      p = p * z + c[i];
-    }
-    return p;
-  };
-  double radius = 0;
+    if (!std::isfinite(A[i])) return false;
+  std::vector<double> a(A, A + n * n), wr(n), wi(n), work(static_cast<size_t>(8 * n));
+  int nn = n, lda = n, ldv = 1, lwork = 8 * n, info = 0;
+  char no = 'N';
+  double dummy = 0;
+  dgeev_(&no, &no, &nn, a.data(), &lda, wr.data(), wi.data(), &dummy, &ldv, &dummy, &ldv,
+         work.data(), &lwork, &info);
+  if (info != 0) return false;
   for (int i = 0; i < n; ++i)
-    radius = std::max(radius, std::abs(c[i]));
-  radius = 1 + radius; // Cauchy bound
-  std::complex<double> z[kMaxSpecies];
-  for (int i = 0; i < n; ++i)
-    z[i] = std::polar(0.5 * radius, 2 * kPi * i / n + 0.4);
-  int polish = 2; // iterations after the steps fall to round-off level (cubic convergence)
-  for (int it = 0; it < 200 && polish > 0; ++it) {
-    double moved = 0;
-    for (int i = 0; i < n; ++i) {
-      std::complex<double> dp;
-      const std::complex<double> p = eval(z[i], dp);
-      if (p == 0.0) continue;
-      const std::complex<double> ratio = p / dp;
-      std::complex<double> sum = 0;
-      for (int j = 0; j < n; ++j)
-        if (j != i) sum += 1.0 / (z[i] - z[j]);
-      const std::complex<double> w = ratio / (1.0 - ratio * sum);
-      if (!std::isfinite(w.real()) || !std::isfinite(w.imag())) continue;
-      z[i] -= w;
-      moved = std::max(moved, std::abs(w) / std::max(1.0, std::abs(z[i])));
-    }
-    if (moved < 1e-13) --polish;
-  }
-  // Real coefficients: roots are real or conjugate pairs; drop round-off imaginary parts.
-  for (int i = 0; i < n; ++i) {
-    if (!std::isfinite(z[i].real()) || !std::isfinite(z[i].imag())) return false;
-    if (std::abs(z[i].imag()) <= 1e-12 * std::max(1.0, std::abs(z[i]))) z[i].imag(0);
-    out[i] = z[i] * scale;
-  }
+    out[i] = {wr[i], wi[i]};
   return true;
 }
 
@@ -387,7 +333,8 @@ DispersionPoint growth_at_k(const StabilityResult& r, const std::array<double, 3
 StabilityResult analyse_jacobian(int n, const double* J, const double* D,
                                  const StabilityOptions& opt) {
   if (n < 1 || n > kMaxSpecies)
-    throw UserError("linear stability: " + std::to_string(n) + " species (1 to 4 supported)");
+    throw UserError("linear stability: " + std::to_string(n) + " species (1 to " +
+                    std::to_string(kMaxSpecies) + " supported)");
   if (opt.samples < 3) throw UserError("linear stability: samples must be at least 3");
   for (int s = 0; s < n; ++s)
     if (!(D[s] >= 0) || !std::isfinite(D[s]))
@@ -778,8 +725,13 @@ std::vector<std::vector<double>> find_steady_states(const ModelInfo& entry,
     lo[s] = s < static_cast<int>(search.lo.size()) ? search.lo[s] : -h;
     hi[s] = s < static_cast<int>(search.hi.size()) ? search.hi[s] : h;
   }
-  static constexpr int auto_points[kMaxSpecies + 1] = {1, 65, 17, 9, 7};
-  const int pts = search.points > 0 ? search.points : auto_points[n];
+  // Starts per species: a grid of pts^n points (about 5,000 or fewer starts).
+  static constexpr int auto_points[5] = {1, 65, 17, 9, 7};
+  const int pts = search.points > 0 ? search.points
+                  : n <= 4          ? auto_points[n]
+                  : n <= 8          ? 3
+                  : n <= 12         ? 2
+                                    : 1;
   long long starts = 1;
   for (int s = 0; s < n; ++s)
     starts *= pts;

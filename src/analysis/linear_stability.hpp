@@ -1,6 +1,6 @@
 // Linear (Turing / Hopf) stability of a homogeneous steady state u* of
 //
-//   du_s/dt = D_s lap u_s + R_s(u; p),   s = 0..N-1 (N <= 4).
+//   du_s/dt = D_s lap u_s + R_s(u; p),   s = 0..N-1 (N <= 64).
 //
 // A perturbation e exp(i k.x + lambda t) grows or decays with lambda an eigenvalue of
 //
@@ -22,9 +22,7 @@
 //   turing_unstable     stable_homogeneous and max_{k>0} sigma(k) > tol
 //   marginal            |max_k sigma(k)| <= tol (on a Turing or Hopf threshold)
 //   oscillatory_fastest the fastest k > 0 has |Im lambda| > tol (wave instability)
-// Eigenvalues: closed form for N = 2; otherwise the roots of the characteristic polynomial
-// (Faddeev-LeVerrier, Aberth-Ehrlich iteration) - LAPACK's dgeev is not used because
-// morphogen_core does not link LAPACK directly (PETSc's pkg-config gives only -lpetsc).
+// Eigenvalues: closed form for N = 2; otherwise LAPACK's dgeev (Debian's liblapack).
 // Pure computation: no MPI, no PETSc objects; bad input (sizes, unknown stencil) throws
 // UserError.
 //
@@ -162,9 +160,8 @@ struct AllowedMode {
   long long scanned = 0; // number of modes examined
 };
 
-// Eigenvalues of the row-major n x n matrix A, 1 <= n <= 4 (closed form for n = 2 unless
-// general). Returns false for non-finite input. The general path is accurate to ~1e-15 ||A||
-// for simple eigenvalues, ~1e-8 ||A|| for double and ~1e-5 ||A|| for triple ones.
+// Eigenvalues of the row-major n x n matrix A, 1 <= n <= 64 (closed form for n = 2 unless
+// general, LAPACK dgeev otherwise). Returns false for non-finite input or a failed QR.
 bool eigenvalues(int n, const double* A, std::complex<double>* out, bool general = false);
 
 // q(k) = -symbol of the grid's Laplacian at wave vector k (|k|^2 without a grid).
@@ -215,7 +212,7 @@ AllowedMode fastest_allowed_mode(const StabilityResult& r, const DiscreteGrid& g
 // can be missed.
 struct SteadySearch {
   std::vector<double> lo, hi; // per species; empty: the defaults above
-  int points = 0;             // per species; 0: 65, 17, 9, 7 for 1, 2, 3, 4 species
+  int points = 0; // per species; 0: 65, 17, 9, 7 for 1-4 species, 3 to 8, 2 to 12, else 1
   int max_it = 60;
 };
 std::vector<std::vector<double>> find_steady_states(const ModelInfo& entry,

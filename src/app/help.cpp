@@ -46,6 +46,11 @@ struct Conditional {
 const Conditional kConditional[] = {
     {"source_", "-source_<species> VALUE",
      "source term added to the species' reaction rate; may use t (default: none)"},
+    {"pin_", "-pin_<species> MASK",
+     "cells held at their initial value where the mask is non-zero (default: none)"},
+    {"ts_diffusion", "-ts_diffusion implicit|explicit",
+     "with -integrator ts: diffusion implicit (IMEX) or in the explicit right-hand side "
+     "(default implicit)"},
     {"dirichlet_", "-dirichlet_<species> VALUE",
      "boundary value on Dirichlet faces, an expression of the face position (default: the "
      "species' initial value; with -grid_bc dirichlet)"},

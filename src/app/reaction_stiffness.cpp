@@ -97,8 +97,7 @@ void warn_if_reaction_stiff(const Simulation& sim) {
                "%.3g (Jacobian eigenvalue %s at cell (%lld,%lld,%lld) of the initial state): "
                "the run may blow up; use -dt %.3g or less, or -integrator split\n",
                sim.dt(), b.dt, lambda, static_cast<long long>(b.cell[0]),
-               static_cast<long long>(b.cell[1]), static_cast<long long>(b.cell[2]),
-               0.9 * b.dt);
+               static_cast<long long>(b.cell[1]), static_cast<long long>(b.cell[2]), 0.9 * b.dt);
   std::fflush(stderr);
 }
 

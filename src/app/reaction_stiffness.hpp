@@ -13,8 +13,8 @@
 namespace morphogen {
 
 struct ReactionBound {
-  double dt = 0;                    // the bound (infinity: no decaying mode)
-  std::array<PetscInt, 3> cell{};   // the cell that sets it
+  double dt = 0;                       // the bound (infinity: no decaying mode)
+  std::array<PetscInt, 3> cell{};      // the cell that sets it
   double lambda_re = 0, lambda_im = 0; // its eigenvalue
 };
 

@@ -36,6 +36,7 @@ void print_header(MPI_Comm comm, const Simulation& sim, int level, int levels) {
               sim.stencil().name.c_str(), format_number(sim.dt()).c_str(),
               format_number(sim.stable_dt()).c_str(), static_cast<long long>(sim.steps()), size,
               size == 1 ? "" : "s", sim.output().dir.c_str());
+  PetscPrintf(comm, "%s", sim.terms().describe().c_str());
 }
 
 } // namespace

@@ -73,9 +73,9 @@ void RunOutput::prepare(const Simulation& sim) {
   throw_if_any(comm_, err);
   if (rank_ != 0) return;
   const std::string path = dir + "/options_used.yaml";
-  const std::string text = opt_.to_yaml("# Options of this run, resolved (morphogen " MORPHOGEN_VERSION
-                                        "). Rerun with: morphogen " +
-                                        path + "\n");
+  const std::string text = opt_.to_yaml(
+      "# Options of this run, resolved (morphogen " MORPHOGEN_VERSION "). Rerun with: morphogen " +
+      path + "\n");
   options_tmp_ = path + ".tmp";
   std::FILE* f = std::fopen(options_tmp_.c_str(), "w");
   const bool ok = f && std::fwrite(text.data(), 1, text.size(), f) == text.size() &&

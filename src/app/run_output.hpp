@@ -83,11 +83,11 @@ private:
   double next_snapshot_time_ = 0, next_checkpoint_time_ = 0;
   long long last_snapshot_step_ = -1, last_checkpoint_step_ = -1;
   std::string last_checkpoint_, stop_reason_;
-  std::string dir_;                // -output_dir
-  std::string options_tmp_;        // options_used.yaml.tmp until commit() (rank 0)
-  bool committed_ = false;         // commit() has run
-  bool retire_pending_ = false;    // checkpoints to retire at commit()
-  long long retire_after_ = -1;    // retire those with a step > this (-1: all)
+  std::string dir_;             // -output_dir
+  std::string options_tmp_;     // options_used.yaml.tmp until commit() (rank 0)
+  bool committed_ = false;      // commit() has run
+  bool retire_pending_ = false; // checkpoints to retire at commit()
+  long long retire_after_ = -1; // retire those with a step > this (-1: all)
   FieldSampler sampler_;
   PetscInt sample_every_ = 0;
 };

@@ -151,50 +151,58 @@ void Simulation::check_surface_needs_tensor(const Options& opt) const {
                       "-diffusion tensor (the default l1 = l2 = 1 is isotropic on the surface)");
 }
 
+// Parameters: scalars where constant in space (and time), fields where they vary in space;
+// values using t also go to timed_ (re-evaluated each step).
+void Simulation::read_params(Options& opt, const std::string& base_dir) {
+  params_ = ParamSet{};
+  timed_ = std::make_unique<TimedParams>(*grid_);
+  for (int q = 0; q < model_->nparams; ++q) {
+    const ParamInfo& p = model_->params[q];
+    const std::string key = std::string("params_") + p.name;
+    const std::string help = std::string(p.doc) + " [" + format_double(p.lo) + ", " +
+                             format_double(p.hi) +
+                             "]; a number, expression (may use t), 'v +- a%' or png(...)";
+    const std::string text = opt.string(key, format_double(p.def), help);
+    auto vs = std::make_unique<ValueSpec>(key, text, spec_, seed_, base_dir);
+    params_.names.emplace_back(p.name);
+    if (vs->is_constant()) {
+      const double v = vs->constant_value();
+      if (!(v >= p.lo && v <= p.hi))
+        throw UserError("-" + key + " " + text + ": out of range, " + allowed_range(p.lo, p.hi));
+      params_.scalar.push_back(v);
+      params_.field.emplace_back();
+    } else if (vs->uniform_in_space()) { // depends on t only: a scalar set each step
+      params_.scalar.push_back(std::nan(""));
+      params_.field.emplace_back();
+    } else {
+      params_.scalar.push_back(std::nan(""));
+      params_.field.push_back(grid_->create_global());
+      if (!vs->uses_time()) {
+        PetscScalar* a;
+        MG_PETSC(VecGetArray(params_.field.back(), &a));
+        try {
+          fill_field(*grid_, *vs, a, ArrayLayout::Owned, p.lo, p.hi);
+        } catch (...) {
+          MG_PETSC(VecRestoreArray(params_.field.back(), &a));
+          throw;
+        }
+        MG_PETSC(VecRestoreArray(params_.field.back(), &a));
+      }
+    }
+    if (vs->uses_time()) timed_->add(q, std::move(vs), p.lo, p.hi);
+  }
+  timed_->set_time(params_, 0.0); // checks the values at t = 0 before anything runs
+}
+
 void Simulation::read_model(Options& opt, const std::string& base_dir) {
   seed_ = static_cast<std::uint64_t>(
       opt.integer("seed", 1, 0, std::numeric_limits<PetscInt>::max(),
                   "seed of every random value (hashed with the key and the global cell index)"));
   const bool clamp = opt.flag("clamp", model_->clamp_default,
                               "clamp negative concentrations to 0 after each step");
-  const int ns = model_->nspecies, np = model_->nparams;
+  const int ns = model_->nspecies;
 
-  // Parameters: scalars where constant, fields where they vary.
-  params_.names.clear();
-  for (int q = 0; q < np; ++q) {
-    const ParamInfo& p = model_->params[q];
-    const std::string key = std::string("params_") + p.name;
-    const std::string help = std::string(p.doc) + " [" + format_double(p.lo) + ", " +
-                             format_double(p.hi) + "]; a number, expression, 'v +- a%' or png(...)";
-    const std::string text = opt.string(key, format_double(p.def), help);
-    ValueSpec vs(key, text, spec_, seed_, base_dir);
-    params_.names.emplace_back(p.name);
-    if (vs.uses_time())
-      throw UserError(
-          "-" + key + " " + text +
-          ": time-dependent parameters (t) are not supported by the explicit integrator yet");
-    if (vs.is_constant()) {
-      const double v = vs.constant_value();
-      if (!(v >= p.lo && v <= p.hi))
-        throw UserError("-" + key + " " + text + ": out of range, allowed [" + format_double(p.lo) +
-                        ", " + format_double(p.hi) + "]");
-      params_.scalar.push_back(v);
-      params_.field.emplace_back();
-    } else {
-      VecH f = grid_->create_global();
-      PetscScalar* a;
-      MG_PETSC(VecGetArray(f, &a));
-      try {
-        fill_field(*grid_, vs, a, ArrayLayout::Owned, p.lo, p.hi);
-      } catch (...) {
-        MG_PETSC(VecRestoreArray(f, &a));
-        throw;
-      }
-      MG_PETSC(VecRestoreArray(f, &a));
-      params_.scalar.push_back(std::nan(""));
-      params_.field.push_back(std::move(f));
-    }
-  }
+  read_params(opt, base_dir);
 
   // Species: diffusion, initial values, Dirichlet values.
   species_.clear();
@@ -273,6 +281,7 @@ void Simulation::read_model(Options& opt, const std::string& base_dir) {
       }
     }
   }
+  read_pins(opt, base_dir);
   RowStencil rows;
   to_rows(stencil_, rows);
   const ExplicitIntegrator::RowFn fn =
@@ -285,6 +294,57 @@ void Simulation::read_model(Options& opt, const std::string& base_dir) {
   integrator_->update_ghosts(u_);
 }
 
+// -pin_<species> MASK: cells where the mask is non-zero keep their initial value.
+void Simulation::read_pins(Options& opt, const std::string& base_dir) {
+  pins_.assign(species_.size(), {});
+  any_pins_ = false;
+  const Box& ob = grid_->owned();
+  for (size_t s = 0; s < species_.size(); ++s) {
+    const std::string key = "pin_" + species_[s];
+    const auto text = opt.get(key, "cells of " + species_[s] +
+                                       " held at their initial value: a mask, non-zero where "
+                                       "pinned (expression, png(...)), e.g. 'j < 2'");
+    if (!text) continue;
+    ValueSpec mask(key, *text, spec_, seed_, base_dir);
+    if (mask.uses_time())
+      throw UserError("-" + key + " " + *text + ": a pin mask cannot depend on t");
+    std::vector<double> m(static_cast<size_t>(ob.size()));
+    fill_field(*grid_, mask, m.data(), ArrayLayout::Owned, -kInf, kInf);
+    const PetscScalar* a;
+    MG_PETSC(VecGetArrayRead(u_[s], &a));
+    for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
+      for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j)
+        for (PetscInt i = ob.s[0]; i < ob.s[0] + ob.m[0]; ++i) {
+          const PetscInt o = grid_->owned_index(i, j, k), l = grid_->local_index(i, j, k);
+          if (m[static_cast<size_t>(o)] != 0.0) pins_[s].push_back({l, o, a[l]});
+        }
+    MG_PETSC(VecRestoreArrayRead(u_[s], &a));
+    any_pins_ = true;
+  }
+}
+
+// Pinned cells out of the implicit operators (rows of the DMDA's global numbering).
+void Simulation::pin_matrices() {
+  if (!any_pins_ || !matrices_) return;
+  PetscInt rstart = 0;
+  {
+    VecH g = grid_->create_global();
+    MG_PETSC(VecGetOwnershipRange(g, &rstart, nullptr));
+  }
+  for (size_t s = 0; s < pins_.size(); ++s) {
+    int any = !pins_[s].empty();
+    MPI_Allreduce(MPI_IN_PLACE, &any, 1, MPI_INT, MPI_LOR, comm_);
+    if (!any) continue;
+    std::vector<PetscInt> rows;
+    std::vector<double> values;
+    for (const auto& c : pins_[s]) {
+      rows.push_back(rstart + c.owned);
+      values.push_back(c.value);
+    }
+    matrices_->pin(static_cast<int>(s), rows, values);
+  }
+}
+
 void Simulation::read_time(Options& opt) {
   const std::string kind =
       opt.choice("integrator", "explicit", {"explicit", "split", "ts"},
@@ -294,12 +354,13 @@ void Simulation::read_time(Options& opt) {
                  "every -ts_ option)");
   split_ = kind == "split";
   ts_ = kind == "ts";
-  ts_implicit_diffusion_ =
-      opt.choice("ts_diffusion", "implicit", {"implicit", "explicit"},
-                 "with -integrator ts: diffusion in the implicit part (IMEX, default) or with "
-                 "every other term in the explicit right-hand side (explicit TS types: rk, "
-                 "euler, ssp)") == "implicit";
-  if (!ts_ && opt.is_set("ts_diffusion"))
+  if (ts_)
+    ts_implicit_diffusion_ =
+        opt.choice("ts_diffusion", "implicit", {"implicit", "explicit"},
+                   "with -integrator ts: diffusion in the implicit part (IMEX, default) or with "
+                   "every other term in the explicit right-hand side (explicit TS types: rk, "
+                   "euler, ssp)") == "implicit";
+  else if (opt.is_set("ts_diffusion"))
     throw UserError("-ts_diffusion: applies to -integrator ts only");
   // With grid sequencing every level uses the finest level's dt and stability bound (the
   // bound scales with h^2), so a bad -dt fails before the first level writes anything.
@@ -347,12 +408,13 @@ void Simulation::build_terms() {
   for (size_t s = 0; s < ops_.size(); ++s)
     terms_.add(std::make_unique<DiffusionTerm>(static_cast<int>(s), species_[s], *ops_[s]));
   terms_.add(std::make_unique<ReactionTerm>(*grid_, model_->name, model_->rates, model_->nspecies,
-                                            params_));
+                                            params_, timed_.get()));
   if (sources_->any()) terms_.add(std::make_unique<SourceTerm>(*grid_, *sources_, species_));
   bool clamp = false;
   for (double f : floor_)
     clamp = clamp || std::isfinite(f);
   if (clamp) terms_.add(std::make_unique<ClampFloor>(*grid_, floor_));
+  if (any_pins_) terms_.add(std::make_unique<PinnedCells>(pins_, species_));
   integrator_->use_terms(terms_);
 }
 
@@ -368,9 +430,11 @@ void Simulation::read_ts(Options& opt) {
         "ts_monitor", "snes_type", "ksp_type", "pc_type", "sub_pc_type", "ksp_rtol"})
     opt.known(k);
   const bool implicit = ts_implicit_diffusion_;
-  if (implicit)
+  if (implicit) {
     matrices_ = std::make_unique<OperatorMatrices>(*grid_, *halo_, stencil_, operators(),
                                                    dirichlet_.empty() ? nullptr : &dirichlet_);
+    pin_matrices();
+  }
   ts_integrator_ = std::make_unique<TsIntegrator>(*grid_, *halo_, species_, terms_, matrices_.get(),
                                                   dirichlet_.empty() ? nullptr : &dirichlet_, dt_);
   stepper_ = ts_integrator_.get();
@@ -401,11 +465,13 @@ void Simulation::read_split(Options& opt) {
       opt.integer("split_newton_max_it", 20, 1, 1000, "Newton iteration cap per cell"));
   matrices_ = std::make_unique<OperatorMatrices>(*grid_, *halo_, stencil_, operators(),
                                                  dirichlet_.empty() ? nullptr : &dirichlet_);
+  pin_matrices();
   diffusion_ = std::make_unique<DiffusionSolver>(*grid_, *matrices_, species_, opt);
   diffusion_->prepare(dt_, set.theta);
   split_integrator_ = std::make_unique<SplitIntegrator>(
       *grid_, model_->kernels.reaction_row[params_.any_field() ? 1 : 0], species_, params_, floor_,
       sources_.get(), *diffusion_, set);
+  split_integrator_->use_constraints(terms_);
   stepper_ = split_integrator_.get();
 }
 
@@ -489,6 +555,9 @@ void Simulation::read_snapshot_options(Options& opt) {
 }
 
 void Simulation::step() {
+  // Parameters using t: once per step, at t (explicit Euler) or at the split step's midpoint
+  // (second order with Strang); the TS right-hand side evaluates them at its stage times.
+  if (timed_->any() && !ts_) timed_->set_time(params_, split_ ? t_ + 0.5 * dt_ : t_);
   stepper_->step(u_, t_, dt_, step_ + 1);
   t_ += dt_;
   ++step_;

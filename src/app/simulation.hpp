@@ -7,6 +7,7 @@
 #include "core/options.hpp"
 #include "fields/param_set.hpp"
 #include "fields/source_terms.hpp"
+#include "fields/timed_params.hpp"
 #include "grid/halo.hpp"
 #include "integrators/diffusion_solver.hpp"
 #include "integrators/explicit_integrator.hpp"
@@ -103,6 +104,9 @@ private:
   void read_diffusion_kinds(Options& opt, const std::string& stencil);
   void check_surface_needs_tensor(const Options& opt) const;
   void read_model(Options& opt, const std::string& base_dir);
+  void read_params(Options& opt, const std::string& base_dir);
+  void read_pins(Options& opt, const std::string& base_dir);
+  void pin_matrices();
   void read_time(Options& opt);
   void read_output(Options& opt);
   void read_snapshot_options(Options& opt);
@@ -120,9 +124,12 @@ private:
   std::vector<std::string> species_;
   std::vector<double> D_, floor_;
   ParamSet params_;
+  std::unique_ptr<TimedParams> timed_; // parameters using t
   std::vector<FaceValues> dirichlet_;
   std::vector<VecH> u_;
-  std::vector<bool> tensor_; // per species: -diffusion_S tensor
+  std::vector<bool> tensor_;                         // per species: -diffusion_S tensor
+  std::vector<std::vector<PinnedCells::Cell>> pins_; // per species: this rank's pinned cells
+  bool any_pins_ = false;
   std::vector<std::unique_ptr<DiffusionOperator>> ops_;
   std::unique_ptr<OperatorMatrices> matrices_; // split and TS; before the integrators using it
   std::unique_ptr<SourceTerms> sources_;

@@ -19,6 +19,13 @@ struct ParamSet {
       if (f.get()) return true;
     return false;
   }
+  // For kernels in field mode: each scalar parameter as a row of n copies (empty rows for the
+  // fields). Called again after the scalars change (parameters using t).
+  void expand_scalars(size_t n, std::vector<std::vector<double>>& rows) const {
+    rows.resize(scalar.size());
+    for (size_t q = 0; q < scalar.size(); ++q)
+      rows[q].assign(field[q].get() ? 0 : n, scalar[q]);
+  }
 };
 
 } // namespace morphogen

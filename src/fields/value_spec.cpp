@@ -213,6 +213,8 @@ ValueSpec::ValueSpec(const std::string& key, const std::string& text, const Grid
     uses_t_ = used.count("t") > 0;
     static const std::regex cellwise(R"(\b(square|disk|ball|spots|noise|gnoise|png)\s*\()");
     const bool cell_funcs = std::regex_search(expr, cellwise);
+    uniform_ =
+        (used.empty() || (used.size() == 1 && uses_t_)) && !cell_funcs && perturb_ == Perturb::None;
     if (used.empty() && !cell_funcs && perturb_ == Perturb::None) {
       constant_ = true;
       value_ = P.Eval();

@@ -53,6 +53,8 @@ public:
   bool is_constant() const { return constant_; }
   double constant_value() const { return value_; }
   bool uses_time() const { return uses_t_; }
+  // True when the value depends on t only (the same number at every cell at a given time).
+  bool uniform_in_space() const { return uniform_; }
 
   // Value at global cell (i, j, k) (cell centre), at time t.
   double at_cell(PetscInt i, PetscInt j, PetscInt k, double t = 0.0);
@@ -68,7 +70,7 @@ private:
   GridSpec grid_;
   std::uint64_t seed_, stream_;
   std::unique_ptr<mu::Parser> parser_;
-  bool constant_ = false, uses_t_ = false;
+  bool constant_ = false, uses_t_ = false, uniform_ = false;
   double value_ = 0.0;
   enum class Perturb { None, Uniform, Gauss } perturb_ = Perturb::None;
   double amount_ = 0.0;

@@ -17,8 +17,7 @@ ExplicitIntegrator::ExplicitIntegrator(const Grid& grid, const Halo& halo, RowFn
       floor_(std::move(floor)), params_(params), dirichlet_(dirichlet) {
   to_rows(stencil_, rows_);
   if (params_.any_field())
-    for (size_t q = 0; q < params_.scalar.size(); ++q)
-      const_rows_.emplace_back(params_.field[q].get() ? 0 : grid.owned().m[0], params_.scalar[q]);
+    params_.expand_scalars(static_cast<size_t>(grid.owned().m[0]), const_rows_);
 }
 
 double ExplicitIntegrator::stable_dt(const Stencil& stencil, const std::vector<double>& D) {
@@ -178,6 +177,8 @@ void ExplicitIntegrator::step(std::vector<VecH>& u, std::vector<VecH>& work, dou
 }
 
 void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>& work, double dt) const {
+  if (params_.any_field()) // scalars may have changed (parameters using t)
+    params_.expand_scalars(static_cast<size_t>(grid_.owned().m[0]), const_rows_);
   if (!ops_.empty()) {
     step_general(u, work, dt);
     return;

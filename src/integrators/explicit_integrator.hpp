@@ -72,8 +72,8 @@ private:
   std::vector<double> D_, floor_;
   const ParamSet& params_;
   const std::vector<FaceValues>* dirichlet_;
-  std::vector<std::vector<double>> const_rows_; // constant params expanded to a row (field mode)
-  std::vector<const DiffusionOperator*> ops_;   // general path (empty: fused fast path)
+  mutable std::vector<std::vector<double>> const_rows_; // scalar params as rows (field mode)
+  std::vector<const DiffusionOperator*> ops_;           // general path (empty: fused fast path)
   RowFn pre_fn_ = nullptr;
   mutable std::vector<std::vector<double>> div_; // per species row buffer of the general path
   const TermList* terms_ = nullptr;

@@ -18,9 +18,7 @@ SplitIntegrator::SplitIntegrator(const Grid& grid, ReactionRowFn fn,
     : grid_(grid), fn_(fn), species_(species), params_(params), floor_(std::move(floor)),
       sources_(sources), diffusion_(diffusion), set_(settings) {
   const size_t row = static_cast<size_t>(grid.owned().m[0]);
-  if (params_.any_field())
-    for (size_t q = 0; q < params_.scalar.size(); ++q)
-      const_rows_.emplace_back(params_.field[q].get() ? 0 : row, params_.scalar[q]);
+  if (params_.any_field()) params_.expand_scalars(row, const_rows_);
   row_out_.assign(species.size(), std::vector<double>(row));
   substeps_ = split_substeps(set_.ordering);
   global_ = grid.create_global();
@@ -28,6 +26,8 @@ SplitIntegrator::SplitIntegrator(const Grid& grid, ReactionRowFn fn,
 
 void SplitIntegrator::react(std::vector<VecH>& u, double t0, double dt, PetscInt step) {
   LogScope log_scope(log_events().reaction);
+  if (params_.any_field()) // scalars may have changed (parameters using t)
+    params_.expand_scalars(static_cast<size_t>(grid_.owned().m[0]), const_rows_);
   const int ns = static_cast<int>(species_.size());
   const int np = static_cast<int>(params_.scalar.size());
   std::vector<PetscScalar*> a(ns);
@@ -131,11 +131,15 @@ void SplitIntegrator::step(std::vector<VecH>& u, double t, double dt, PetscInt s
     if (sub.kind == Substep::Kind::Reaction) {
       react(u, t_reaction, sub.fraction * dt, step);
       t_reaction += sub.fraction * dt;
+      if (terms_) terms_->constrain(u);
     } else {
       diffuse(u, sub.fraction * dt, step);
     }
   }
-  apply_floor(grid_, u, floor_);
+  if (terms_)
+    terms_->constrain(u);
+  else
+    apply_floor(grid_, u, floor_);
 }
 
 } // namespace morphogen

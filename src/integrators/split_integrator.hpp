@@ -19,6 +19,7 @@
 #include "integrators/diffusion_solver.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/reaction_kernel.hpp"
+#include "operators/term_list.hpp"
 
 #include <vector>
 
@@ -55,6 +56,10 @@ public:
   // One step from t to t + dt on the ghosted local state vectors (owned cells updated).
   void step(std::vector<VecH>& u, double t, double dt, PetscInt step) override;
 
+  // The run's constraints (pinned cells, clamp floor), applied after every reaction substep
+  // and at the end of the step (without: the clamp floor only).
+  void use_constraints(const TermList& terms) { terms_ = &terms; }
+
   // Largest Newton iteration count of the last reaction substep.
   int last_newton_iterations() const { return last_its_; }
 
@@ -68,6 +73,7 @@ private:
   const ParamSet& params_;
   std::vector<double> floor_;
   SourceTerms* sources_;
+  const TermList* terms_ = nullptr;
   DiffusionSolver& diffusion_;
   SplitSettings set_;
   std::vector<Substep> substeps_;

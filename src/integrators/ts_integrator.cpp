@@ -341,6 +341,10 @@ void TsIntegrator::add_rhs_terms(const PetscScalar* xl, double t, PetscScalar* g
           ns_);
   for (const Term* term : rhs_)
     term->add_rates(state, t, rates);
+  if (const PinnedCells* pins = terms_.pins()) // held cells do not move
+    for (int s = 0; s < pins->nspecies(); ++s)
+      for (const PinnedCells::Cell& c : pins->cells(s))
+        g[ns_ * c.owned + s] = 0.0;
 }
 
 // J = shift I - blockdiag(D_s L), refreshed only when the shift changed.

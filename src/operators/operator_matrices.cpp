@@ -34,6 +34,36 @@ OperatorMatrices::OperatorMatrices(const Grid& grid, const Halo& halo, const Ste
     index_.push_back(0);
     scale_.push_back(1.0);
   }
+  pinned_M_.resize(static_cast<size_t>(ns));
+  pinned_b_.resize(static_cast<size_t>(ns));
+}
+
+void OperatorMatrices::pin(int s, const std::vector<PetscInt>& rows,
+                           const std::vector<double>& values) {
+  MatH M;
+  MG_PETSC(MatDuplicate(this->M(s), MAT_COPY_VALUES, M.out()));
+  MG_PETSC(MatSetOption(M, MAT_KEEP_NONZERO_PATTERN, PETSC_TRUE));
+  VecH x, c;
+  MG_PETSC(MatCreateVecs(M, x.out(), c.out()));
+  MG_PETSC(VecSet(x, 0.0));
+  MG_PETSC(VecSet(c, 0.0));
+  const PetscInt n = static_cast<PetscInt>(rows.size());
+  MG_PETSC(VecSetValues(x, n, rows.data(), values.data(), INSERT_VALUES));
+  MG_PETSC(VecAssemblyBegin(x));
+  MG_PETSC(VecAssemblyEnd(x));
+  // c_i = -sum_p M_ip x_p off the pinned rows, 0 on them (diag 0).
+  MG_PETSC(MatZeroRowsColumns(M, n, rows.data(), 0.0, x, c));
+  MG_PETSC(VecScale(c, -1.0));
+  if (has_dirichlet_) {
+    MG_PETSC(VecAXPY(c, 1.0, b(s)));
+    const std::vector<double> zeros(rows.size(), 0.0);
+    MG_PETSC(VecSetValues(c, n, rows.data(), zeros.data(), INSERT_VALUES));
+    MG_PETSC(VecAssemblyBegin(c));
+    MG_PETSC(VecAssemblyEnd(c));
+  }
+  pinned_M_[static_cast<size_t>(s)] = std::move(M);
+  pinned_b_[static_cast<size_t>(s)] = std::move(c);
+  has_dirichlet_ = true;
 }
 
 } // namespace morphogen

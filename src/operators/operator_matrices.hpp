@@ -25,11 +25,17 @@ public:
                    const std::vector<FaceValues>* dirichlet);
 
   int nspecies() const { return static_cast<int>(scale_.size()); }
-  Mat M(int s) const { return mat_[s]->L(); }
-  Vec b(int s) const { return mat_[s]->b(index_[s]); }
+  Mat M(int s) const { return pinned_M_[s] ? pinned_M_[s].get() : mat_[s]->L(); }
+  Vec b(int s) const { return pinned_b_[s] ? pinned_b_[s].get() : mat_[s]->b(index_[s]); }
+  // Hold species s at `values` on the cells `rows` (this rank's, in the DMDA's global
+  // numbering): rows and columns of M_s are zeroed (the matrix stays symmetric) and the
+  // coupling to the held values moves into b_s, whose pinned rows are 0, so K_s u = 0 there.
+  // Collective.
+  void pin(int s, const std::vector<PetscInt>& rows, const std::vector<double>& values);
   double scale(int s) const { return scale_[s]; }
   // False where the operator is not symmetric (first-order tensor masks): CG does not apply.
   bool symmetric(int s) const { return symmetric_[s]; }
+  // True when any b_s may be non-zero (Dirichlet data or pinned cells).
   bool has_dirichlet() const { return has_dirichlet_; }
 
 private:
@@ -37,6 +43,8 @@ private:
   std::vector<int> index_; // which of the matrix's b vectors is species s's
   std::vector<double> scale_;
   std::vector<bool> symmetric_;
+  std::vector<MatH> pinned_M_; // per species: own matrix when pinned (else null)
+  std::vector<VecH> pinned_b_;
   bool has_dirichlet_ = false;
 };
 

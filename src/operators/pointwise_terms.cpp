@@ -7,15 +7,16 @@
 namespace morphogen {
 
 ReactionTerm::ReactionTerm(const Grid& grid, std::string model, RatesFn rates, int nspecies,
-                           const ParamSet& params)
-    : grid_(grid), model_(std::move(model)), rates_(rates), ns_(nspecies), params_(params) {
+                           ParamSet& params, TimedParams* timed)
+    : grid_(grid), model_(std::move(model)), rates_(rates), ns_(nspecies), params_(params),
+      timed_(timed) {
   if (!rates_ || params_.scalar.size() != params_.field.size())
     throw std::logic_error("ReactionTerm: no rates or inconsistent parameters");
 }
 
-void ReactionTerm::add_rates(const StateArrays& state, double /*t*/,
-                             const RateArrays& rates) const {
+void ReactionTerm::add_rates(const StateArrays& state, double t, const RateArrays& rates) const {
   LogScope log_scope(log_events().reaction);
+  if (timed_ && timed_->any()) timed_->set_time(params_, t);
   const size_t ns = static_cast<size_t>(ns_), np = params_.scalar.size();
   std::vector<const PetscScalar*> pf(np, nullptr);
   for (size_t q = 0; q < np; ++q)

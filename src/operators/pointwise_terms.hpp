@@ -5,6 +5,7 @@
 
 #include "fields/param_set.hpp"
 #include "fields/source_terms.hpp"
+#include "fields/timed_params.hpp"
 #include "operators/term.hpp"
 
 namespace morphogen {
@@ -12,12 +13,14 @@ namespace morphogen {
 class ReactionTerm : public Term {
 public:
   using RatesFn = void (*)(const double* u, const double* p, double* r);
-  // Keeps references to grid and params.
-  ReactionTerm(const Grid& grid, std::string model, RatesFn rates, int nspecies,
-               const ParamSet& params);
+  // Keeps references to grid, params and timed (null: no parameter uses t). With timed
+  // parameters add_rates first evaluates them at its t (the TS stage times).
+  ReactionTerm(const Grid& grid, std::string model, RatesFn rates, int nspecies, ParamSet& params,
+               TimedParams* timed = nullptr);
 
   Kind kind() const override { return Kind::Reaction; }
   std::string describe() const override { return "reaction (" + model_ + ")"; }
+  bool uses_time() const override { return timed_ && timed_->any(); }
   void add_rates(const StateArrays& state, double t, const RateArrays& rates) const override;
 
 private:
@@ -25,7 +28,8 @@ private:
   std::string model_;
   RatesFn rates_;
   int ns_;
-  const ParamSet& params_;
+  ParamSet& params_;
+  TimedParams* timed_;
 };
 
 class SourceTerm : public Term {

@@ -39,6 +39,12 @@ double TermList::stable_dt() const {
   return dt;
 }
 
+const PinnedCells* TermList::pins() const {
+  for (const auto& c : constraints_)
+    if (const auto* p = dynamic_cast<const PinnedCells*>(c.get())) return p;
+  return nullptr;
+}
+
 PetscInt TermList::constrain(std::vector<VecH>& u) const {
   PetscInt n = 0;
   for (const auto& c : constraints_)

@@ -36,6 +36,8 @@ public:
   }
   // Largest stable forward-Euler dt of the diffusion terms (min over terms). Collective.
   double stable_dt() const;
+  // The pinned-cells constraint, or null.
+  const PinnedCells* pins() const;
   // Apply every constraint; returns the values changed on this rank.
   PetscInt constrain(std::vector<VecH>& u) const;
   // One line per term and constraint (for the run's banner and -help).

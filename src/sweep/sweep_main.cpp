@@ -18,10 +18,30 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
+#include <sstream>
 
 namespace morphogen::sweep {
 
 namespace {
+
+// The sweep's own keys, then the points' keys that the sweep did not write (both read some
+// options, e.g. -max_walltime; a deck must not repeat a key). One "key: value" per line.
+std::string merge_yaml_keys(const std::string& first, const std::string& second) {
+  std::set<std::string> keys;
+  std::istringstream a(first);
+  for (std::string line; std::getline(a, line);)
+    if (const auto c = line.find(':'); c != std::string::npos && line[0] != '#')
+      keys.insert(line.substr(0, c));
+  std::string out = first;
+  std::istringstream b(second);
+  for (std::string line; std::getline(b, line);) {
+    const auto c = line.find(':');
+    if (c != std::string::npos && line[0] != '#' && keys.count(line.substr(0, c))) continue;
+    out += line + "\n";
+  }
+  return out;
+}
 
 namespace fs = std::filesystem;
 
@@ -203,9 +223,10 @@ int run_sweep(int* argc, char*** argv, const std::vector<OptionsFileArg>& option
     if (ec)
       err = "-output_dir " + dir + ": cannot create " + dir + "/points (" + ec.message() + ")";
     if (err.empty()) {
-      const std::string werr = io::write_file_atomically(
-          dir + "/options_used.yaml",
-          "# Options of this sweep (morphogen " MORPHOGEN_VERSION ")\n" + sopt.to_yaml("") + yaml);
+      const std::string werr =
+          io::write_file_atomically(dir + "/options_used.yaml",
+                                    "# Options of this sweep (morphogen " MORPHOGEN_VERSION ")\n" +
+                                        merge_yaml_keys(sopt.to_yaml(""), yaml));
       if (!werr.empty()) err = "-output_dir " + dir + ": " + werr;
     }
     for (long long p = s.chunk; p < npoints; p += s.chunks)

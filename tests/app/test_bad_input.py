@@ -62,7 +62,7 @@ def error_lines(proc):
     for l in proc.stderr.splitlines():
         if l.startswith("-----"):
             break
-        if l.strip():
+        if l.strip() and not l.startswith("morphogen: warning:"):  # e.g. a stiff reaction's dt
             lines.append(l)
     return lines
 
