@@ -114,7 +114,7 @@ void Simulation::read_grid(Options& opt, const SequenceLevel& level) {
   if (!make_stencil(st, spec_.dim, h, stencil_))
     throw UserError("-stencil " + st +
                     ": the isotropic 9pt stencil needs equal spacing hx = hy (got " +
-                    format_double(h[0]) + " and " + format_double(h[1]) + ")");
+                    format_number(h[0]) + " and " + format_number(h[1]) + ")");
   spec_.stencil_width = 1;
   spec_.box_stencil = stencil_.nterms == 9;
   read_diffusion_kinds(opt, st);
@@ -159,9 +159,8 @@ void Simulation::read_params(Options& opt, const std::string& base_dir) {
   for (int q = 0; q < model_->nparams; ++q) {
     const ParamInfo& p = model_->params[q];
     const std::string key = std::string("params_") + p.name;
-    const std::string help = std::string(p.doc) + " [" + format_double(p.lo) + ", " +
-                             format_double(p.hi) +
-                             "]; a number, expression (may use t), 'v +- a%' or png(...)";
+    const std::string help = std::string(p.doc) + " (" + allowed_range(p.lo, p.hi) +
+                             "); a number, expression (may use t), 'v +- a%' or png(...)";
     const std::string text = opt.string(key, format_double(p.def), help);
     auto vs = std::make_unique<ValueSpec>(key, text, spec_, seed_, base_dir);
     params_.names.emplace_back(p.name);
@@ -370,7 +369,7 @@ void Simulation::read_time(Options& opt) {
                static_cast<double>(level_factor_ * level_factor_);
   const double def_dt = std::isfinite(stable_dt_) ? 0.9 * stable_dt_ : 1.0;
   dt_ = opt.real("dt", def_dt, 0.0, kMaxReal, "time step");
-  if (!(dt_ > 0)) throw UserError("-dt " + format_double(dt_) + ": must be > 0");
+  if (!(dt_ > 0)) throw UserError("-dt " + format_number(dt_) + ": must be > 0");
   if (!split_ && !(ts_ && ts_implicit_diffusion_)) {
     const bool force = opt.flag("force_dt", false,
                                 "run even when -dt exceeds the explicit diffusion stability bound");
@@ -379,18 +378,18 @@ void Simulation::read_time(Options& opt) {
       lmax = std::max(lmax, op->max_eigenvalue());
     if (dt_ > stable_dt_ && !force && !constant)
       throw UserError(
-          "-dt " + format_double(dt_) +
-          ": exceeds the explicit diffusion stability bound dt <= " + format_double(stable_dt_) +
+          "-dt " + format_number(dt_) +
+          ": exceeds the explicit diffusion stability bound dt <= " + format_number(stable_dt_) +
           " (2/(lambda_max*rho(L)), the largest eigenvalue of the diffusion "
           "tensors/maps over the grid lambda_max = " +
-          format_double(lmax) +
+          format_number(lmax) +
           "); use a smaller -dt, -integrator split (unconditionally stable "
           "diffusion), or -force_dt");
     if (dt_ > stable_dt_ && !force)
       throw UserError(
-          "-dt " + format_double(dt_) + ": exceeds the explicit diffusion stability bound dt <= " +
-          format_double(stable_dt_) + " (2/(D_max*rho(L)) for the " + stencil_.name +
-          " stencil, D_max = " + format_double(*std::max_element(D_.begin(), D_.end())) +
+          "-dt " + format_number(dt_) + ": exceeds the explicit diffusion stability bound dt <= " +
+          format_number(stable_dt_) + " (2/(D_max*rho(L)) for the " + stencil_.name +
+          " stencil, D_max = " + format_number(*std::max_element(D_.begin(), D_.end())) +
           "); use a smaller -dt, -integrator split (unconditionally stable "
           "diffusion), or -force_dt");
   }
@@ -590,10 +589,10 @@ void Simulation::check_finite() const {
         for (PetscInt i = ob.s[0]; i < ob.s[0] + ob.m[0]; ++i) {
           const double v = a[grid_->local_index(i, j, k)];
           if (!(std::fabs(v) <= kBlowup)) { // NaN, Inf or blown up
-            err = "species " + species_[s] + " became " + format_double(v) +
+            err = "species " + species_[s] + " became " + format_number(v) +
                   (std::isfinite(v) ? " (over the blow-up bound 1e10)" : "") + " at cell (" +
                   std::to_string(i) + "," + std::to_string(j) + "," + std::to_string(k) +
-                  ") by step " + std::to_string(step_) + " (t = " + format_double(t_) +
+                  ") by step " + std::to_string(step_) + " (t = " + format_number(t_) +
                   "): the run diverged; reduce -dt" +
                   (floor_[s] == 0.0 ? std::string() : std::string(" or try -clamp true"));
             break;

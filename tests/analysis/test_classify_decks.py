@@ -2,7 +2,7 @@
 its summary.json (written at the end of every run: pattern class per species from the final
 field and 1,000 samples of the run) must give the class its header describes: Sanderson et al.
 Figs. 1 and 3, Garrity's four Gray-Scott presets, Pearson's spots, a Barkley spiral and the
-Brusselator's hexagons (the diffusion-tensor decks: test_classify_tensor_decks.py). Classes of
+Brusselator's hexagons and its stripes from fixed rows (Fig. 20, pinned cells) (the diffusion-tensor decks: test_classify_tensor_decks.py). Classes of
 spots refer to the species: Turing's spots are high in b, so the same run is `holes` in a."""
 import json
 import os
@@ -26,6 +26,7 @@ EXPECTED = {
     "gray_scott_pearson_spots": {"a": "spots"},                 # Pearson's self-replicating spots
     "barkley_spiral": {"A": "oscillating"},                     # a rotating spiral
     "brusselator": {"b": "spots"},                              # hexagonal spots
+    "brusselator_fixed_rows": {"a": "stripes", "b": "stripes"},  # Fig. 20 left: pinned rows
 }
 
 

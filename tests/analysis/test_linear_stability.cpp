@@ -66,8 +66,11 @@ bool contains(const std::string& s, const std::string& p) {
 std::vector<std::complex<double>> sorted_eigs(int n, const double* A, bool general) {
   std::vector<std::complex<double>> ev(n);
   EXPECT_TRUE(eigenvalues(n, A, ev.data(), general));
-  std::sort(ev.begin(), ev.end(), [](auto a, auto b) {
-    return a.real() != b.real() ? a.real() < b.real() : a.imag() < b.imag();
+  // By real part rounded to 1e-8 (a conjugate pair's real parts may differ in the last bits,
+  // e.g. in a Debug build), then by imaginary part.
+  const auto key = [](std::complex<double> z) { return std::llround(z.real() * 1e8); };
+  std::sort(ev.begin(), ev.end(), [&](auto a, auto b) {
+    return key(a) != key(b) ? key(a) < key(b) : a.imag() < b.imag();
   });
   return ev;
 }
