@@ -364,8 +364,9 @@ void Simulation::read_time(Options& opt) {
   // With grid sequencing every level uses the finest level's dt and stability bound (the
   // bound scales with h^2), so a bad -dt fails before the first level writes anything.
   const bool constant = all_constant_diffusion();
-  stable_dt_ = (constant ? ExplicitIntegrator::stable_dt(stencil_, D_)
-                         : ExplicitIntegrator::stable_dt(operators())) /
+  sources_ = std::make_unique<SourceTerms>(*grid_, opt, species_, seed_, base_dir_);
+  build_terms();
+  stable_dt_ = (constant ? ExplicitIntegrator::stable_dt(stencil_, D_) : terms_.stable_dt()) /
                static_cast<double>(level_factor_ * level_factor_);
   const double def_dt = std::isfinite(stable_dt_) ? 0.9 * stable_dt_ : 1.0;
   dt_ = opt.real("dt", def_dt, 0.0, kMaxReal, "time step");
@@ -395,8 +396,6 @@ void Simulation::read_time(Options& opt) {
   }
   steps_ =
       opt.integer("steps", 1000, 0, std::numeric_limits<PetscInt>::max(), "number of time steps");
-  sources_ = std::make_unique<SourceTerms>(*grid_, opt, species_, seed_, base_dir_);
-  build_terms();
   stepper_ = integrator_.get();
   if (ts_) read_ts(opt);
   if (split_) read_split(opt);

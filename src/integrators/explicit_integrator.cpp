@@ -28,13 +28,6 @@ double ExplicitIntegrator::stable_dt(const Stencil& stencil, const std::vector<d
   return dmax > 0 && rho > 0 ? 2.0 / (dmax * rho) : std::numeric_limits<double>::infinity();
 }
 
-double ExplicitIntegrator::stable_dt(const std::vector<const DiffusionOperator*>& ops) {
-  double r = 0;
-  for (const DiffusionOperator* op : ops)
-    r = std::max(r, op->radius());
-  return r > 0 ? 2.0 / r : std::numeric_limits<double>::infinity();
-}
-
 void ExplicitIntegrator::use_operators(std::vector<const DiffusionOperator*> ops, RowFn pre_fn) {
   ops_ = std::move(ops);
   pre_fn_ = pre_fn;

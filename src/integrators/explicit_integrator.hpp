@@ -49,8 +49,6 @@ public:
 
   // Largest stable dt for this stencil and these diffusion coefficients (inf if D = 0).
   static double stable_dt(const Stencil& stencil, const std::vector<double>& D);
-  // Largest stable dt for these operators: 2 / max radius (inf if all are zero).
-  static double stable_dt(const std::vector<const DiffusionOperator*>& ops);
 
   // Switch to the general path: each species' diffusion from its operator (into a row buffer),
   // then pre_fn adds the reaction and writes the row (explicit_row_pre of the model). Used when

@@ -37,12 +37,13 @@ TsIntegrator::TsIntegrator(const Grid& grid, const Halo& halo,
   terms_.diffusion(static_cast<int>(ns_)); // throws unless one diffusion term per species
   if (ops_ && ops_->nspecies() != static_cast<int>(ns_))
     throw std::logic_error("TsIntegrator: species and operator matrices disagree");
+  // The right-hand side: every term but the diffusion when that is implicit.
+  const auto in_rhs = [this](const Term& t) {
+    return !(ops_ && t.kind() == Term::Kind::Diffusion);
+  };
   for (const auto& t : terms_.terms())
-    if (!(ops_ && t->kind() == Term::Kind::Diffusion)) rhs_.push_back(t.get());
-  for (const Term* t : rhs_) {
-    rhs_halo_.width = std::max(rhs_halo_.width, t->halo().width);
-    rhs_halo_.box = rhs_halo_.box || t->halo().box;
-  }
+    if (in_rhs(*t)) rhs_.push_back(t.get());
+  rhs_halo_ = terms_.halo(in_rhs);
   if (rhs_halo_.width > grid.spec().stencil_width || (rhs_halo_.box && !grid.spec().box_stencil))
     throw std::logic_error("TsIntegrator: a term needs more halo than the grid has");
   MG_PETSC(DMDACreateCompatibleDMDA(grid.dm(), ns_, dm_.out()));
