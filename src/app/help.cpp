@@ -17,7 +17,8 @@ bool starts_with(const std::string& s, const std::string& p) {
 const std::vector<std::pair<const char*, std::vector<const char*>>>& topics() {
   static const std::vector<std::pair<const char*, std::vector<const char*>>> groups = {
       {"Model and values",
-       {"model", "params_", "D_", "init_", "dirichlet_", "source_", "clamp", "seed"}},
+       {"model", "layers", "species", "rate_", "params_", "D_", "init_", "dirichlet_", "source_",
+        "pin_", "clamp", "seed"}},
       {"Grid", {"grid_", "stencil", "sequence_"}},
       {"Diffusion", {"diffusion", "tensor_", "surface_"}},
       {"Time integration", {"integrator", "dt", "force_dt", "steps", "split_", "ts_"}},
@@ -125,6 +126,14 @@ void print_models_help(MPI_Comm comm) {
                   format_number(m.params[q].def).c_str(),
                   allowed_range(m.params[q].lo, m.params[q].hi).c_str(), m.params[q].doc);
   }
+  PetscPrintf(comm, "  %-18s %s\n", "custom",
+              "user-defined kinetics: -species a,b and -rate_a EXPR, -rate_b EXPR (muParser, "
+              "functions of the species); every other name in a rate is a parameter, given "
+              "with -params_NAME");
+  PetscPrintf(comm, "  %-18s %s\n", "-layers L",
+              "L coupled copies of any model (Sanderson et al. 2006, eqs. 20-21): species a1, "
+              "b1, a2, b2, ...; parameters alpha1, ...; coupling rates -params_couple_a, ... "
+              "between neighbouring layers");
 }
 
 std::string other_model_hint(const std::string& option, const std::string& model) {

@@ -1,6 +1,7 @@
 #include "app/simulation.hpp"
 
 #include "app/diffusion_setup.hpp"
+#include "app/model_setup.hpp"
 #include "core/collective_error.hpp"
 #include "core/log_events.hpp"
 #include "core/user_error.hpp"
@@ -124,8 +125,7 @@ void Simulation::read_grid(Options& opt, const SequenceLevel& level) {
 }
 
 void Simulation::read_diffusion_kinds(Options& opt, const std::string& stencil) {
-  const std::string name = opt.choice("model", "turing", model_names(), "reaction model");
-  model_ = find_model(name);
+  model_ = read_model_choice(opt);
   tensor_.clear();
   for (int s = 0; s < model_->nspecies; ++s) {
     tensor_.push_back(read_tensor_choice(opt, model_->species[s].name));
@@ -283,11 +283,12 @@ void Simulation::read_model(Options& opt, const std::string& base_dir) {
   read_pins(opt, base_dir);
   RowStencil rows;
   to_rows(stencil_, rows);
+  const ModelKernels& mk = model_->kernels;
   const ExplicitIntegrator::RowFn fn =
-      model_->kernels.row_kernel(params_.any_field(), rows.nrows, rows.box);
+      mk.fused ? mk.row_kernel(params_.any_field(), rows.nrows, rows.box) : nullptr;
   integrator_ = std::make_unique<ExplicitIntegrator>(
       *grid_, *halo_, fn, ns, stencil_, D_, floor_, params_, any_dirichlet ? &dirichlet_ : nullptr);
-  if (!all_constant_diffusion())
+  if (!mk.fused || !all_constant_diffusion())
     integrator_->use_operators(operators(),
                                model_->kernels.explicit_pre[params_.any_field() ? 1 : 0]);
   integrator_->update_ghosts(u_);

@@ -116,7 +116,7 @@ private:
 
   MPI_Comm comm_;
   std::string base_dir_;
-  const ModelEntry* model_ = nullptr;
+  std::shared_ptr<const ModelEntry> model_; // registry entry or a model built at run time
   GridSpec spec_;
   std::unique_ptr<Grid> grid_;
   std::unique_ptr<Halo> halo_;

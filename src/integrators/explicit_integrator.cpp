@@ -28,9 +28,9 @@ double ExplicitIntegrator::stable_dt(const Stencil& stencil, const std::vector<d
   return dmax > 0 && rho > 0 ? 2.0 / (dmax * rho) : std::numeric_limits<double>::infinity();
 }
 
-void ExplicitIntegrator::use_operators(std::vector<const DiffusionOperator*> ops, RowFn pre_fn) {
+void ExplicitIntegrator::use_operators(std::vector<const DiffusionOperator*> ops, PreFn pre_fn) {
   ops_ = std::move(ops);
-  pre_fn_ = pre_fn;
+  pre_fn_ = std::move(pre_fn);
   div_.assign(static_cast<size_t>(ns_), std::vector<double>(grid_.owned().m[0]));
 }
 

@@ -25,6 +25,7 @@
 #include "operators/diffusion_operator.hpp"
 #include "operators/term_list.hpp"
 
+#include <functional>
 #include <vector>
 
 namespace morphogen {
@@ -32,6 +33,8 @@ namespace morphogen {
 class ExplicitIntegrator : public Integrator {
 public:
   using RowFn = void (*)(const ExplicitRow&);
+  // The general path's row update (a std::function: a model built at run time carries state).
+  using PreFn = std::function<void(const ExplicitRow&)>;
   // row_fn must match (nspecies, nparams, the stencil's row form, params.any_field()).
   ExplicitIntegrator(const Grid& grid, const Halo& halo, RowFn row_fn, int nspecies,
                      const Stencil& stencil, std::vector<double> D, std::vector<double> floor,
@@ -53,7 +56,7 @@ public:
   // Switch to the general path: each species' diffusion from its operator (into a row buffer),
   // then pre_fn adds the reaction and writes the row (explicit_row_pre of the model). Used when
   // any operator is not constant isotropic; the fused fast path is kept otherwise.
-  void use_operators(std::vector<const DiffusionOperator*> ops, RowFn pre_fn);
+  void use_operators(std::vector<const DiffusionOperator*> ops, PreFn pre_fn);
   bool general() const { return !ops_.empty(); }
 
 private:
@@ -72,7 +75,7 @@ private:
   const std::vector<FaceValues>* dirichlet_;
   mutable std::vector<std::vector<double>> const_rows_; // scalar params as rows (field mode)
   std::vector<const DiffusionOperator*> ops_;           // general path (empty: fused fast path)
-  RowFn pre_fn_ = nullptr;
+  PreFn pre_fn_;
   mutable std::vector<std::vector<double>> div_; // per species row buffer of the general path
   const TermList* terms_ = nullptr;
   std::vector<const Term*> others_;        // terms evaluated through add_rates

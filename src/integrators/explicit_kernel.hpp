@@ -90,22 +90,24 @@ inline void explicit_row(const ExplicitRow& a) {
 // The general path's update of one row: the diffusion terms were computed into div[s] (a row
 // buffer, operators/diffusion_operator.hpp) and are added with the reaction:
 //   out_s = max( u_s + dt (div_s + R_s(u; p)),  floor_s )
-// src[s] is species s's row (one row per species, no neighbours read).
-template <class M, bool FieldParams> inline void explicit_row_pre(const ExplicitRow& a) {
-  constexpr int NS = M::nspecies;
-  constexpr int NP = M::nparams;
+// src[s] is species s's row (one row per species, no neighbours read). explicit_row_pre_of
+// takes a model object m (rates(u, p, r) may carry state) with NS species and np <= NPMax
+// parameters; explicit_row_pre<M, FieldParams> is it for a model type.
+template <int NS, int NPMax, bool FieldParams, class Model>
+inline void explicit_row_pre_of(const Model& m, int np, const ExplicitRow& a) {
+  constexpr int NPA = NPMax > 0 ? NPMax : 1;
   const double* __restrict__ src[NS];
   const double* __restrict__ div[NS];
   double* __restrict__ dst[NS];
-  double floor[NS], pc[NP > 0 ? NP : 1];
-  const double* __restrict__ prow[NP > 0 ? NP : 1];
+  double floor[NS], pc[NPA];
+  const double* __restrict__ prow[NPA];
   for (int s = 0; s < NS; ++s) {
     src[s] = a.src[s];
     div[s] = a.div[s];
     dst[s] = a.dst[s];
     floor[s] = a.floor[s];
   }
-  for (int q = 0; q < NP; ++q) {
+  for (int q = 0; q < np; ++q) {
     if constexpr (FieldParams)
       prow[q] = a.prow[q];
     else
@@ -115,8 +117,8 @@ template <class M, bool FieldParams> inline void explicit_row_pre(const Explicit
   const int n = a.n;
 #pragma GCC ivdep
   for (int i = 0; i < n; ++i) {
-    double u[NS], r[NS], p[NP > 0 ? NP : 1];
-    for (int q = 0; q < NP; ++q) {
+    double u[NS], r[NS], p[NPA];
+    for (int q = 0; q < np; ++q) {
       if constexpr (FieldParams)
         p[q] = prow[q][i];
       else
@@ -124,12 +126,16 @@ template <class M, bool FieldParams> inline void explicit_row_pre(const Explicit
     }
     for (int s = 0; s < NS; ++s)
       u[s] = src[s][i];
-    M::rates(u, p, r);
+    m.rates(u, p, r);
     for (int s = 0; s < NS; ++s) {
       const double v = u[s] + dt * (div[s][i] + r[s]);
       dst[s][i] = clamp_to_floor(v, floor[s]);
     }
   }
+}
+
+template <class M, bool FieldParams> inline void explicit_row_pre(const ExplicitRow& a) {
+  explicit_row_pre_of<M::nspecies, M::nparams, FieldParams>(M{}, M::nparams, a);
 }
 
 } // namespace morphogen

@@ -10,6 +10,7 @@
 #include "integrators/split_integrator.hpp"
 #include "models/all_models.hpp"
 
+#include <functional>
 #include <stdexcept>
 
 namespace morphogen {
@@ -21,16 +22,21 @@ using ExplicitRowFn = void (*)(const ExplicitRow&);
 enum class RowLayout { Star3 = 0, Star5 = 1, Box3 = 2 };
 constexpr int kRowLayouts = 3;
 
+// A model built at run time (models/runtime_model.hpp) has no fused kernels (fused = false:
+// the explicit integrator takes its general path) and generic pre/reaction rows that call its
+// kinetics (integrators/runtime_kernels.hpp).
 struct ModelKernels {
-  ExplicitRowFn explicit_row[2][kRowLayouts]; // [field_params][layout]
-  ExplicitRowFn explicit_pre[2];              // [field_params]
-  ReactionRowFn reaction_row[2];              // [field_params]
+  bool fused = true;
+  ExplicitRowFn explicit_row[2][kRowLayouts] = {};         // [field_params][layout]
+  std::function<void(const ExplicitRow&)> explicit_pre[2]; // [field_params]
+  ReactionRowFn reaction_row[2];                           // [field_params]
 
   // The fused kernel of a row stencil; throws std::logic_error for a layout without one
   // (callers check the stencil first: there are no null entries to call).
   ExplicitRowFn row_kernel(bool field_params, int nrows, bool box) const {
     const int idx = !box && nrows == 3 ? 0 : !box && nrows == 5 ? 1 : box && nrows == 3 ? 2 : -1;
-    if (idx < 0) throw std::logic_error("no fused explicit kernel for this stencil layout");
+    if (idx < 0 || !fused)
+      throw std::logic_error("no fused explicit kernel for this stencil layout");
     return explicit_row[field_params ? 1 : 0][idx];
   }
 };

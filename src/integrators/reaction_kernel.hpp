@@ -9,10 +9,11 @@
 //   BackwardEuler  F(v) = v - u - dt (R(v) + S1)                      = 0  (order 1, L-stable)
 //   Trapezoidal    F(v) = v - u - dt/2 (R(u) + S0 + R(v) + S1)        = 0  (order 2, A-stable)
 // The implicit rules are the per-cell "implicit update rules" of the stable-ARD paper
-// (Appendix A); instead of eliminating one species by hand per model, the 2..8-species system is
+// (Appendix A); instead of eliminating one species by hand per model, the 1..16-species system is
 // solved by Newton with the model's analytic Jacobian,
 //   J_F = I - c dt dR/du(v),  c = 1 (BackwardEuler) or 1/2 (Trapezoidal),
-// factored by a dense LU with partial pivoting (stack arrays sized by M::nspecies <= 8).
+// factored by a dense LU with partial pivoting (stack arrays sized by the number of species, at
+// most 16).
 //
 // Newton start: the explicit Euler predictor v0 = u + dt R(u) + dt (c S1 + (1 - c) S0) or u
 // itself, whichever has the smaller max-norm residual (a non-finite predictor loses).
@@ -61,7 +62,7 @@ struct CellSolve {
 
 namespace detail {
 
-constexpr int kMaxSpecies = 8;
+constexpr int kMaxSpecies = 16;
 constexpr int kMaxHalvings = 10; // Newton damping: smallest step fraction 2^-10
 
 template <int N> inline double max_abs(const double* x) {
@@ -148,18 +149,19 @@ template <int N> inline bool lu_solve(double* A, double* b) {
 
 // One cell: see the header comment. u, S0, S1 and v have M::nspecies entries (S0/S1 may be
 // nullptr for a zero source), p has M::nparams. v must not alias u.
-template <class M>
-inline CellSolve reaction_cell(ReactionScheme scheme, const double* u, const double* p,
-                               const double* S0, const double* S1, double dt, double tol, int maxit,
-                               double* v) {
-  constexpr int NS = M::nspecies;
-  static_assert(NS >= 1 && NS <= detail::kMaxSpecies, "reaction_cell: 1..8 species");
+// reaction_cell_of is the same for a model object m whose rates(u, p, r) and jacobian(u, p, J)
+// may carry state (a model built at run time); NS is its number of species.
+template <int NS, class Model>
+inline CellSolve reaction_cell_of(const Model& m, ReactionScheme scheme, const double* u,
+                                  const double* p, const double* S0, const double* S1, double dt,
+                                  double tol, int maxit, double* v) {
+  static_assert(NS >= 1 && NS <= detail::kMaxSpecies, "reaction_cell: 1..16 species");
   double s0[NS], s1[NS], ru[NS];
   for (int s = 0; s < NS; ++s) {
     s0[s] = S0 ? S0[s] : 0.0;
     s1[s] = S1 ? S1[s] : 0.0;
   }
-  M::rates(u, p, ru);
+  m.rates(u, p, ru);
   CellSolve out{0, 0.0, false};
 
   if (scheme == ReactionScheme::Euler) {
@@ -174,7 +176,7 @@ inline CellSolve reaction_cell(ReactionScheme scheme, const double* u, const dou
       k1[s] = ru[s] + s0[s];
       w[s] = u[s] + dt * k1[s];
     }
-    M::rates(w, p, rw);
+    m.rates(w, p, rw);
     for (int s = 0; s < NS; ++s)
       v[s] = u[s] + 0.5 * dt * (k1[s] + rw[s] + s1[s]);
     out.converged = detail::all_finite<NS>(v);
@@ -191,7 +193,7 @@ inline CellSolve reaction_cell(ReactionScheme scheme, const double* u, const dou
   }
   const double unorm = detail::max_abs<NS>(u);
   auto residual = [&](const double* x, double* f) {
-    M::rates(x, p, r);
+    m.rates(x, p, r);
     for (int s = 0; s < NS; ++s)
       f[s] = x[s] - base[s] - cdt * (r[s] + s1[s]);
     return detail::max_abs<NS>(f);
@@ -225,7 +227,7 @@ inline CellSolve reaction_cell(ReactionScheme scheme, const double* u, const dou
   double J[NS * NS], dv[NS], vt[NS], Ft[NS];
   const double big_step = std::sqrt(tol);
   for (int it = 1; it <= maxit; ++it) {
-    M::jacobian(v, p, J);
+    m.jacobian(v, p, J);
     for (int q = 0; q < NS * NS; ++q)
       J[q] *= -cdt;
     for (int s = 0; s < NS; ++s) {
@@ -267,34 +269,40 @@ inline CellSolve reaction_cell(ReactionScheme scheme, const double* u, const dou
   return out;
 }
 
+template <class M>
+inline CellSolve reaction_cell(ReactionScheme scheme, const double* u, const double* p,
+                               const double* S0, const double* S1, double dt, double tol, int maxit,
+                               double* v) {
+  return reaction_cell_of<M::nspecies>(M{}, scheme, u, p, S0, S1, dt, tol, maxit, v);
+}
+
 // One row of n cells: see the header comment. u, S0, S1 and out are [NS] row pointers (S0/S1
-// nullptr for a zero source), prow [NP] parameter rows (FieldParams) or pconst [NP] scalars,
-// floor [NS] lower clamps. worst may be nullptr.
-template <class M, bool FieldParams>
-inline int reaction_row(ReactionScheme scheme, int n, const double* const* u,
-                        const double* const* prow, const double* pconst, const double* const* S0,
-                        const double* const* S1, double dt, double tol, int maxit,
-                        const double* floor, double* const* out, CellSolve* worst) {
-  constexpr int NS = M::nspecies;
-  constexpr int NP = M::nparams > 0 ? M::nparams : 1;
-  static_assert(NS >= 1 && NS <= detail::kMaxSpecies, "reaction_row: 1..8 species");
-  double p[NP] = {};
+// nullptr for a zero source), prow [np] parameter rows (FieldParams) or pconst [np] scalars,
+// floor [NS] lower clamps. worst may be nullptr. reaction_row_of takes a model object m with
+// NS species and np <= NPMax parameters; reaction_row<M, FieldParams> is it for a model type.
+template <int NS, int NPMax, bool FieldParams, class Model>
+inline int reaction_row_of(const Model& m, int np, ReactionScheme scheme, int n,
+                           const double* const* u, const double* const* prow, const double* pconst,
+                           const double* const* S0, const double* const* S1, double dt, double tol,
+                           int maxit, const double* floor, double* const* out, CellSolve* worst) {
+  static_assert(NS >= 1 && NS <= detail::kMaxSpecies, "reaction_row: 1..16 species");
+  double p[NPMax > 0 ? NPMax : 1] = {};
   if constexpr (!FieldParams)
-    for (int q = 0; q < M::nparams; ++q)
+    for (int q = 0; q < np; ++q)
       p[q] = pconst[q];
   CellSolve acc{0, 0.0, true};
   for (int i = 0; i < n; ++i) {
     double uc[NS], a[NS], b[NS], v[NS];
     if constexpr (FieldParams)
-      for (int q = 0; q < M::nparams; ++q)
+      for (int q = 0; q < np; ++q)
         p[q] = prow[q][i];
     for (int s = 0; s < NS; ++s) {
       uc[s] = u[s][i];
       if (S0) a[s] = S0[s][i];
       if (S1) b[s] = S1[s][i];
     }
-    const CellSolve cs =
-        reaction_cell<M>(scheme, uc, p, S0 ? a : nullptr, S1 ? b : nullptr, dt, tol, maxit, v);
+    const CellSolve cs = reaction_cell_of<NS>(m, scheme, uc, p, S0 ? a : nullptr, S1 ? b : nullptr,
+                                              dt, tol, maxit, v);
     if (!cs.converged) {
       if (worst) *worst = cs;
       return i;
@@ -306,6 +314,15 @@ inline int reaction_row(ReactionScheme scheme, int n, const double* const* u,
   }
   if (worst) *worst = acc;
   return -1;
+}
+
+template <class M, bool FieldParams>
+inline int reaction_row(ReactionScheme scheme, int n, const double* const* u,
+                        const double* const* prow, const double* pconst, const double* const* S0,
+                        const double* const* S1, double dt, double tol, int maxit,
+                        const double* floor, double* const* out, CellSolve* worst) {
+  return reaction_row_of<M::nspecies, M::nparams, FieldParams>(
+      M{}, M::nparams, scheme, n, u, prow, pconst, S0, S1, dt, tol, maxit, floor, out, worst);
 }
 
 } // namespace morphogen

@@ -21,13 +21,17 @@
 #include "integrators/reaction_kernel.hpp"
 #include "operators/term_list.hpp"
 
+#include <functional>
 #include <vector>
 
 namespace morphogen {
 
-using ReactionRowFn = int (*)(ReactionScheme, int, const double* const*, const double* const*,
-                              const double*, const double* const*, const double* const*, double,
-                              double, int, const double*, double* const*, CellSolve*);
+// A row of reaction substeps (reaction_row's signature); a std::function so that a model built
+// at run time can carry its kinetics.
+using ReactionRowFn =
+    std::function<int(ReactionScheme, int, const double* const*, const double* const*,
+                      const double*, const double* const*, const double* const*, double, double,
+                      int, const double*, double* const*, CellSolve*)>;
 
 enum class SplitOrdering { Lie, Strang };
 

@@ -7,12 +7,19 @@
 #include "models/all_models.hpp"
 #include "models/model.hpp"
 
+#include <functional>
+#include <memory>
 #include <string>
 #include <tuple>
 #include <utility>
 #include <vector>
 
 namespace morphogen {
+
+// Kinetics as callables: a model type's static functions, or a model built at run time
+// (models/runtime_model.hpp: coupled layers, user-defined rates) whose state `storage` owns.
+using RatesFn = std::function<void(const double* u, const double* p, double* r)>;
+using SteadyFn = std::function<bool(const double* p, double* u)>;
 
 struct ModelInfo {
   const char* name;
@@ -23,15 +30,16 @@ struct ModelInfo {
   const SpeciesInfo* species;
   const ParamInfo* params;
   bool clamp_default;
-  void (*rates)(const double* u, const double* p, double* r);
-  void (*jacobian)(const double* u, const double* p, double* J);
-  bool (*steady_state)(const double* p, double* u);
+  RatesFn rates;
+  RatesFn jacobian; // J[s*N+q] = dR_s/du_q
+  SteadyFn steady_state;
+  std::shared_ptr<const void> storage; // names and kinetics of a model built at run time
 };
 
 template <class M> ModelInfo model_info() {
   return {M::name,           M::doc,           M::reference,     M::nspecies, M::nparams,
           M::species.data(), M::params.data(), M::clamp_default, &M::rates,   &M::jacobian,
-          &M::steady_state};
+          &M::steady_state,  nullptr};
 }
 
 namespace detail {

@@ -8,8 +8,8 @@ namespace morphogen {
 
 ReactionTerm::ReactionTerm(const Grid& grid, std::string model, RatesFn rates, int nspecies,
                            ParamSet& params, TimedParams* timed)
-    : grid_(grid), model_(std::move(model)), rates_(rates), ns_(nspecies), params_(params),
-      timed_(timed) {
+    : grid_(grid), model_(std::move(model)), rates_(std::move(rates)), ns_(nspecies),
+      params_(params), timed_(timed) {
   if (!rates_ || params_.scalar.size() != params_.field.size())
     throw std::logic_error("ReactionTerm: no rates or inconsistent parameters");
 }

@@ -8,11 +8,13 @@
 #include "fields/timed_params.hpp"
 #include "operators/term.hpp"
 
+#include <functional>
+
 namespace morphogen {
 
 class ReactionTerm : public Term {
 public:
-  using RatesFn = void (*)(const double* u, const double* p, double* r);
+  using RatesFn = std::function<void(const double* u, const double* p, double* r)>;
   // Keeps references to grid, params and timed (null: no parameter uses t). With timed
   // parameters add_rates first evaluates them at its t (the TS stage times).
   ReactionTerm(const Grid& grid, std::string model, RatesFn rates, int nspecies, ParamSet& params,

@@ -1,0 +1,72 @@
+#include "app/model_setup.hpp"
+
+#include "core/user_error.hpp"
+#include "integrators/runtime_kernels.hpp"
+#include "models/runtime_model.hpp"
+
+#include <stdexcept>
+
+namespace morphogen {
+
+namespace {
+
+ModelInfo read_custom(Options& opt) {
+  CustomKinetics spec;
+  if (!opt.is_set("species"))
+    throw UserError("-model custom: give the species (-species a,b) and each one's rate "
+                    "(-rate_a EXPR, -rate_b EXPR)");
+  spec.species = opt.list("species", {}, 1, kMaxRuntimeSpecies,
+                          "species of the custom model, comma-separated (e.g. a,b)");
+  for (const auto& s : spec.species) {
+    const std::string key = "rate_" + s;
+    const auto text = opt.get(key, "rate of " + s +
+                                       " (custom model): an expression of the "
+                                       "species and parameters");
+    if (!text)
+      throw UserError("-species " + s + ": the custom model needs its rate, -" + key +
+                      " EXPR (e.g. \"k*a - a*b\")");
+    spec.rates.push_back(*text);
+    spec.keys.push_back("-" + key);
+  }
+  ModelInfo m = custom_model(spec);
+  std::string species;
+  for (const auto& s : spec.species)
+    species += (species.empty() ? "" : ", ") + s;
+  for (int q = 0; q < m.nparams; ++q) {
+    const std::string n = m.params[q].name;
+    if (!opt.is_set("params_" + n))
+      throw UserError("-rate_*: '" + n + "' is neither a species (" + species +
+                      ") nor given a value: add -params_" + n + " VALUE");
+  }
+  return m;
+}
+
+std::shared_ptr<const ModelEntry> runtime_entry(const ModelInfo& info) {
+  try {
+    return std::make_shared<const ModelEntry>(ModelEntry{info, runtime_model_kernels(info)});
+  } catch (const std::invalid_argument& e) {
+    throw UserError(std::string("-model ") + info.name + ": " + e.what());
+  }
+}
+
+} // namespace
+
+std::vector<std::string> model_choices() {
+  std::vector<std::string> names = model_names();
+  names.emplace_back("custom");
+  return names;
+}
+
+std::shared_ptr<const ModelEntry> read_model_choice(Options& opt) {
+  const std::string name = opt.choice("model", "turing", model_choices(), "reaction model");
+  const PetscInt layers =
+      opt.integer("layers", 1, 1, 16,
+                  "coupled layers of the model (species a1, b1, a2, ...; coupling rates "
+                  "-params_couple_<species>)");
+  if (name != "custom" && layers == 1) // the registry's entry, not owned
+    return std::shared_ptr<const ModelEntry>(find_model(name), [](const ModelEntry*) {});
+  const ModelInfo base = name == "custom" ? read_custom(opt) : ModelInfo(*find_model(name));
+  return runtime_entry(layers > 1 ? layered_model(base, static_cast<int>(layers)) : base);
+}
+
+} // namespace morphogen
