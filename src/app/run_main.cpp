@@ -74,8 +74,14 @@ int run_main(int* argc, char*** argv, double wall_start,
     print_models_help(comm);
     return 0;
   }
-  const std::string model = first->model().name;
-  opt.set_unknown_hint([model](const std::string& name) { return other_model_hint(name, model); });
+  const ModelEntry& m = first->model();
+  std::string species; // a run-time model's own names (layers: a1, b1, ...; custom)
+  for (int s = 0; s < m.nspecies && m.storage; ++s)
+    species += (species.empty() ? "" : ", ") + std::string(m.species[s].name);
+  const std::string model = m.name;
+  opt.set_unknown_hint([model, species](const std::string& name) {
+    return species.empty() ? other_model_hint(name, model) : "this run's species are " + species;
+  });
   opt.check_unused();
   // A directory name that cannot be created whole fails before any parent is created.
   if (const std::string bad = directory_name_problem(first->output().dir); !bad.empty())

@@ -9,16 +9,22 @@ namespace morphogen {
 
 namespace {
 
+using PlainRates = void (*)(const double*, const double*, double*);
+
 struct Layers {
   ModelInfo base;
   int L = 0, ns = 0, np = 0;
+  PlainRates plain = nullptr; // base.rates when it is a compiled model's function (no indirection)
 
   // Coupling rate of base species s (the parameters after the layers' own).
   double couple(const double* p, int s) const { return p[L * np + s]; }
 
   void rates(const double* u, const double* p, double* r) const {
     for (int l = 0; l < L; ++l)
-      base.rates(u + l * ns, p + l * np, r + l * ns);
+      if (plain)
+        plain(u + l * ns, p + l * np, r + l * ns);
+      else
+        base.rates(u + l * ns, p + l * np, r + l * ns);
     for (int s = 0; s < ns; ++s) {
       const double k = couple(p, s);
       if (k == 0.0) continue;
@@ -95,7 +101,9 @@ ModelInfo layered_model(const ModelInfo& base, int layers) {
                      1e6,
                      std::string("coupling rate of ") + base.species[s].name +
                          " between neighbouring layers (mu, nu of eqs. 20-21)");
-  auto kin = std::make_shared<const Layers>(Layers{base, layers, base.nspecies, base.nparams});
+  const PlainRates* plain = base.rates.target<PlainRates>();
+  auto kin = std::make_shared<const Layers>(
+      Layers{base, layers, base.nspecies, base.nparams, plain ? *plain : nullptr});
   ModelInfo m{};
   m.clamp_default = base.clamp_default;
   m.rates = [kin](const double* u, const double* p, double* r) { kin->rates(u, p, r); };

@@ -2,7 +2,8 @@
 its summary.json (written at the end of every run: pattern class per species from the final
 field and 1,000 samples of the run) must give the class its header describes: Sanderson et al.
 Figs. 1 and 3, Garrity's four Gray-Scott presets, Pearson's spots, a Barkley spiral and the
-Brusselator's hexagons and its stripes from fixed rows (Fig. 20, pinned cells) (the diffusion-tensor decks: test_classify_tensor_decks.py). Classes of
+Brusselator's hexagons, its stripes from fixed rows (Fig. 20, pinned cells) and two coupled
+Brusselator layers' spots on spots (Fig. 10) (the diffusion-tensor decks: test_classify_tensor_decks.py). Classes of
 spots refer to the species: Turing's spots are high in b, so the same run is `holes` in a."""
 import json
 import os
@@ -27,6 +28,7 @@ EXPECTED = {
     "barkley_spiral": {"A": "oscillating"},                     # a rotating spiral
     "brusselator": {"b": "spots"},                              # hexagonal spots
     "brusselator_fixed_rows": {"a": "stripes", "b": "stripes"},  # Fig. 20 left: pinned rows
+    "brusselator_spot_on_spot": {"b1": "spots", "b2": "spots"},  # Fig. 10: coupled layers
 }
 
 

@@ -30,6 +30,8 @@ EXPECTED = {
     "turing_circles_first_order": {"b": "spots"},               # Fig. 7 left (a: holes at 0.85)
     "turing_circles_second_order": {"a": "holes", "b": "spots"},  # Fig. 7 right
     "witkin_kass_oriented_stripes": {"a": "stripes", "b": "stripes"},  # stripes along 30 deg
+    "witkin_kass_zebra": {"cp": "stripes", "cm": "stripes"},  # custom threshold pair (WK Fig. 3)
+    "brusselator_double_spots": {"b1": "spots", "b2": "spots"},  # Sanderson Fig. 18
     "turing_diffusion_map": {"a": "holes", "b": "spots"},       # graded spot sizes
     "turing_torus": {"a": "holes", "b": "spots"},               # spots for a torus
 }
@@ -166,3 +168,20 @@ def test_tensor_3d_pattern_stretched_along_the_tensor(deck_run):
     angle = math.degrees(math.acos(min(1.0, abs(axis @ np.array([1, 1, 0]) / math.sqrt(2)))))
     assert w[0] < 0.4, w
     assert angle <= 10.0, (angle, axis, w)
+
+
+def test_double_spots_are_oblong_along_x(deck_run):
+    """Sanderson Fig. 18: the coupled layers' spots under the uniform tensor (1.25 along x,
+    0.75 along y) are oblong along x in both layers: median elongation of the spots >= 1.2
+    (about 1.13 for the isotropic Fig. 10 deck) and median |major-axis angle| <= 15 degrees
+    (measured 1.30-1.34 and 3.5-7 degrees)."""
+    import numpy as np
+    out = deck_run("brusselator_double_spots")
+    for species in ("b1", "b2"):
+        u, h, periodic, _ = final_field(out, species)
+        shapes = spot_shapes.spot_shapes(u, h, periodic)
+        assert len(shapes) >= 20, (species, len(shapes))
+        elongation = float(np.median([s["elongation"] for s in shapes]))
+        angle = float(np.median([abs(s["angle_deg"]) for s in shapes]))
+        assert elongation >= 1.2, (species, elongation)
+        assert angle <= 15.0, (species, angle)
