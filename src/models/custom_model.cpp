@@ -15,8 +15,8 @@ namespace morphogen {
 namespace {
 
 // Names a rate expression may not use for a species or parameter: the coordinates, time and
-// the constants (a parameter can depend on x, y, z, t: -params_k "0.1*x").
-const std::set<std::string> kReserved = {"x", "y", "z", "t", "pi", "e"};
+// the constant pi (a parameter can depend on x, y, z, t: -params_k "0.1*x").
+const std::set<std::string> kReserved = {"x", "y", "z", "t", "pi"};
 
 bool is_identifier(const std::string& n) {
   if (n.empty() || !(std::isalpha(static_cast<unsigned char>(n[0])) || n[0] == '_')) return false;
@@ -62,7 +62,7 @@ void check_species(const CustomKinetics& spec) {
     if (!is_identifier(n) || kReserved.count(n))
       throw UserError("-species " + n +
                       ": not a usable species name (letters, digits and _, starting with a "
-                      "letter; not x, y, z, t, pi or e)");
+                      "letter; not x, y, z, t or pi)");
     if (!seen.insert(n).second) throw UserError("-species " + n + ": given twice");
   }
 }
@@ -77,7 +77,6 @@ std::vector<std::string> parse_all(const CustomKinetics& spec, Expressions& ex) 
       throw UserError(spec.keys[s] + ": empty rate expression");
     try {
       P->DefineConst("pi", M_PI);
-      P->DefineConst("e", M_E);
       P->SetExpr(text);
       for (const auto& used : P->GetUsedVar()) { // parses; lists undefined names too
         const std::string& n = used.first;

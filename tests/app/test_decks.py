@@ -110,6 +110,10 @@ def test_deck_runs(deck, workdir, model_species):
     with open(deck) as f:
         cfg = yaml.safe_load(f)
     species = model_species[used["model"]]
+    if used["model"] == "custom":  # a user-defined model: the deck's own species
+        species = [x.strip() for x in used["species"].split(",")]
+    if int(used.get("layers", "1")) > 1:  # coupled layers: a1, b1, a2, b2, ...
+        species = [f"{x}{l}" for l in range(1, int(used["layers"]) + 1) for x in species]
     if "png_species" in cfg:
         species = [s.strip() for s in str(cfg["png_species"]).split(",")]
     assert used["png_species"].split(",") == species, used["png_species"]
