@@ -34,7 +34,7 @@ ModelInfo read_custom(Options& opt) {
     species += (species.empty() ? "" : ", ") + s;
   for (int q = 0; q < m.nparams; ++q) {
     const std::string n = m.params[q].name;
-    if (!opt.is_set("params_" + n))
+    if (!m.params[q].def_text && !opt.is_set("params_" + n))
       throw UserError("-rate_*: '" + n + "' is neither a species (" + species +
                       ") nor given a value: add -params_" + n + " VALUE");
   }

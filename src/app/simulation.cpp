@@ -161,7 +161,7 @@ void Simulation::read_params(Options& opt, const std::string& base_dir) {
     const std::string key = std::string("params_") + p.name;
     const std::string help = std::string(p.doc) + " (" + allowed_range(p.lo, p.hi) +
                              "); a number, expression (may use t), 'v +- a%' or png(...)";
-    const std::string text = opt.string(key, format_double(p.def), help);
+    const std::string text = opt.string(key, p.def_text ? p.def_text : format_double(p.def), help);
     auto vs = std::make_unique<ValueSpec>(key, text, spec_, seed_, base_dir);
     params_.names.emplace_back(p.name);
     if (vs->is_constant()) {

@@ -14,9 +14,11 @@ namespace morphogen {
 
 namespace {
 
-// Names a rate expression may not use for a species or parameter: the coordinates, time and
-// the constant pi (a parameter can depend on x, y, z, t: -params_k "0.1*x").
+// Names a species may not have: the coordinates, time and the constant pi. In a rate, x, y, z
+// and t are parameters whose default is that expression (a field of x, a value set each step
+// for t), so they cost nothing when unused.
 const std::set<std::string> kReserved = {"x", "y", "z", "t", "pi"};
+const std::set<std::string> kCoordinates = {"x", "y", "z", "t"};
 
 bool is_identifier(const std::string& n) {
   if (n.empty() || !(std::isalpha(static_cast<unsigned char>(n[0])) || n[0] == '_')) return false;
@@ -81,10 +83,6 @@ std::vector<std::string> parse_all(const CustomKinetics& spec, Expressions& ex) 
       for (const auto& used : P->GetUsedVar()) { // parses; lists undefined names too
         const std::string& n = used.first;
         if (std::count(spec.species.begin(), spec.species.end(), n)) continue;
-        if (kReserved.count(n))
-          throw UserError(spec.keys[s] + " " + text + ": '" + n +
-                          "' cannot appear in a rate (rates are functions of the species and "
-                          "parameters; make a parameter depend on x, y, t: -params_k '0.1*t')");
         if (!std::count(params.begin(), params.end(), n)) params.push_back(n);
       }
     } catch (const mu::Parser::exception_type& e) {
@@ -124,7 +122,10 @@ ModelInfo custom_model(const CustomKinetics& spec) {
   for (size_t s = 0; s < spec.species.size(); ++s)
     names->add_species(spec.species[s], 1.0, 0.0, "species of " + spec.keys[s]);
   for (const auto& p : params)
-    names->add_param(p, std::nan(""), -big, big, "parameter of the custom rates");
+    if (kCoordinates.count(p))
+      names->add_param(p, std::nan(""), -big, big, p + " in the custom rates", p);
+    else
+      names->add_param(p, std::nan(""), -big, big, "parameter of the custom rates");
   ModelInfo m{};
   m.clamp_default = false;
   m.rates = [ex](const double* u, const double* p, double* r) { ex->rates(u, p, r); };

@@ -28,6 +28,7 @@ struct ParamInfo {
   double lo;  // allowed range, inclusive
   double hi;
   const char* doc;
+  const char* def_text = nullptr; // default as an expression (e.g. "x"), overriding def
 };
 
 struct SpeciesInfo {

@@ -23,7 +23,8 @@ namespace morphogen {
 ModelInfo layered_model(const ModelInfo& base, int layers);
 
 // User-defined kinetics: R_s = rates[s], a muParser expression of the species and of any other
-// name, which becomes a parameter (parameters in alphabetical order). keys[s] names the option of
+// name, which becomes a parameter (parameters in alphabetical order); x, y, z and t are
+// parameters whose default is that expression. keys[s] names the option of
 // rates[s] in messages (e.g. "-rate_a"). Jacobian by central differences; no steady state is
 // claimed (the analysis searches for one). Throws UserError on a bad name or expression.
 struct CustomKinetics {

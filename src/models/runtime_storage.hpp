@@ -12,7 +12,7 @@ namespace morphogen::detail {
 
 struct RuntimeNames {
   std::string name, doc, reference;
-  std::vector<std::string> species_names, species_docs, param_names, param_docs;
+  std::vector<std::string> species_names, species_docs, param_names, param_docs, param_texts;
   std::vector<SpeciesInfo> species;
   std::vector<ParamInfo> params;
 
@@ -21,10 +21,13 @@ struct RuntimeNames {
     species_docs.push_back(std::move(doc));
     species.push_back({nullptr, D, init, nullptr});
   }
-  void add_param(std::string n, double def, double lo, double hi, std::string doc) {
+  // def_text: a default given as an expression ("" for none: def).
+  void add_param(std::string n, double def, double lo, double hi, std::string doc,
+                 std::string def_text = "") {
     param_names.push_back(std::move(n));
     param_docs.push_back(std::move(doc));
-    params.push_back({nullptr, def, lo, hi, nullptr});
+    param_texts.push_back(std::move(def_text));
+    params.push_back({nullptr, def, lo, hi, nullptr, nullptr});
   }
   // Points the infos at the owned strings and fills m's descriptors (the kinetics are the
   // caller's); `self` keeps this alive as long as any copy of m.
@@ -32,7 +35,8 @@ struct RuntimeNames {
     for (size_t s = 0; s < species.size(); ++s)
       species[s].name = species_names[s].c_str(), species[s].doc = species_docs[s].c_str();
     for (size_t q = 0; q < params.size(); ++q)
-      params[q].name = param_names[q].c_str(), params[q].doc = param_docs[q].c_str();
+      params[q].name = param_names[q].c_str(), params[q].doc = param_docs[q].c_str(),
+      params[q].def_text = param_texts[q].empty() ? nullptr : param_texts[q].c_str();
     m.name = name.c_str();
     m.doc = doc.c_str();
     m.reference = reference.c_str();
