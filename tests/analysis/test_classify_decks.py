@@ -29,6 +29,7 @@ EXPECTED = {
     "brusselator": {"b": "spots"},                              # hexagonal spots
     "brusselator_fixed_rows": {"a": "stripes", "b": "stripes"},  # Fig. 20 left: pinned rows
     "brusselator_spot_on_spot": {"b1": "spots", "b2": "spots"},  # Fig. 10: coupled layers
+    "brusselator_aligned_spots": {"a2": "stripes", "b2": "stripes"},  # Fig. 21: aligned by mu
 }
 
 
