@@ -21,7 +21,7 @@ ModelInfo read_custom(Options& opt) {
     const std::string key = "rate_" + s;
     const auto text = opt.get(key, "rate of " + s +
                                        " (custom model): an expression of the "
-                                       "species and parameters");
+                                       "species, x, y, z, t and parameters");
     if (!text)
       throw UserError("-species " + s + ": the custom model needs its rate, -" + key +
                       " EXPR (e.g. \"k*a - a*b\")");

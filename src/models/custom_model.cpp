@@ -76,7 +76,9 @@ std::vector<std::string> parse_all(const CustomKinetics& spec, Expressions& ex) 
     auto P = std::make_unique<mu::Parser>();
     const std::string& text = spec.rates[s];
     if (text.find_first_not_of(" \t") == std::string::npos)
-      throw UserError(spec.keys[s] + ": empty rate expression");
+      throw UserError(spec.keys[s] +
+                      ": empty rate expression (on the command line a value that starts with "
+                      "'-' is read as an option name: write \"0 - k*a\" or \" -k*a\")");
     try {
       P->DefineConst("pi", M_PI);
       P->SetExpr(text);
