@@ -10,7 +10,8 @@ namespace morphogen {
 
 namespace {
 
-ModelInfo read_custom(Options& opt) {
+// Under -layers L each parameter p of the rates is given per layer (-params_p1, ...).
+ModelInfo read_custom(Options& opt, int layers) {
   CustomKinetics spec;
   if (!opt.is_set("species"))
     throw UserError("-model custom: give the species (-species a,b) and each one's rate "
@@ -32,12 +33,13 @@ ModelInfo read_custom(Options& opt) {
   std::string species;
   for (const auto& s : spec.species)
     species += (species.empty() ? "" : ", ") + s;
-  for (int q = 0; q < m.nparams; ++q) {
-    const std::string n = m.params[q].name;
-    if (!m.params[q].def_text && !opt.is_set("params_" + n))
-      throw UserError("-rate_*: '" + n + "' is neither a species (" + species +
-                      ") nor given a value: add -params_" + n + " VALUE");
-  }
+  for (int q = 0; q < m.nparams; ++q)
+    for (int l = 1; l <= layers && !m.params[q].def_text; ++l) {
+      const std::string n = m.params[q].name + (layers > 1 ? std::to_string(l) : "");
+      if (!opt.is_set("params_" + n))
+        throw UserError("-rate_*: '" + std::string(m.params[q].name) + "' is neither a species (" +
+                        species + ") nor given a value: add -params_" + n + " VALUE");
+    }
   return m;
 }
 
@@ -65,7 +67,8 @@ std::shared_ptr<const ModelEntry> read_model_choice(Options& opt) {
                   "-params_couple_<species>)");
   if (name != "custom" && layers == 1) // the registry's entry, not owned
     return std::shared_ptr<const ModelEntry>(find_model(name), [](const ModelEntry*) {});
-  const ModelInfo base = name == "custom" ? read_custom(opt) : ModelInfo(*find_model(name));
+  const ModelInfo base =
+      name == "custom" ? read_custom(opt, static_cast<int>(layers)) : ModelInfo(*find_model(name));
   return runtime_entry(layers > 1 ? layered_model(base, static_cast<int>(layers)) : base);
 }
 

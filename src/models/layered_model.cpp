@@ -94,7 +94,8 @@ ModelInfo layered_model(const ModelInfo& base, int layers) {
     for (int q = 0; q < base.nparams; ++q) {
       const ParamInfo& pi = base.params[q];
       names->add_param(unique(pi.name + std::to_string(l), "parameter"), pi.def, pi.lo, pi.hi,
-                       std::string(pi.doc) + " (layer " + std::to_string(l) + ")");
+                       std::string(pi.doc) + " (layer " + std::to_string(l) + ")",
+                       pi.def_text ? pi.def_text : "");
     }
   for (int s = 0; s < base.nspecies; ++s)
     names->add_param(unique(std::string("couple_") + base.species[s].name, "parameter"), 0.0, 0.0,

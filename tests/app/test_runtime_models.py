@@ -160,3 +160,29 @@ def test_custom_gray_scott_matches_compiled(tmp_path, integrator):
     tol = 1e-13 if integrator[0] == "-dt" else 1e-11
     for s in "ab":
         assert np.max(np.abs(fg[s] - fc[s])) < tol, (s, np.max(np.abs(fg[s] - fc[s])))
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_decoupled_layers_equal_independent_runs_bitwise(tmp_path, ranks):
+    """Two layers of a custom model with mu = nu = 0 equal two independent runs of the single
+    model (layer 2 with other parameters and D) bitwise: both take the general explicit path."""
+    one = ["-model", "custom", "-species", "a,b"] + BRUSS_RATES + GRID + [
+        "-dt", "0.01", "-steps", "200", "-checkpoint_every", "200"]
+    layers = {"1": (PARAMS, ["-D_a", "4", "-D_b", "10"], INIT),
+              "2": (["-params_alpha", "2.5", "-params_beta", "8", "-params_s", "0.8"],
+                    ["-D_a", "3", "-D_b", "12"], "2.5 + 0.05*cos(2*pi*x/Lx)")}
+    two = ["-model", "custom", "-species", "a,b", "-layers", "2", "-params_couple_a", "0",
+           "-params_couple_b", "0"] + BRUSS_RATES + GRID + [
+        "-dt", "0.01", "-steps", "200", "-checkpoint_every", "200", "-output_dir", "two"]
+    for l, (params, D, init) in layers.items():
+        run_ok(one + params + D + ["-init_a", init, "-init_b", INIT, "-output_dir", "one" + l],
+               tmp_path, ranks)
+        two += [params[i] + l if i % 2 == 0 else params[i] for i in range(len(params))]
+        two += [D[0] + l, D[1], D[2] + l, D[3], "-init_a" + l, init, "-init_b" + l, INIT]
+    run_ok(two, tmp_path, ranks)
+    f2 = fields(tmp_path / "two")
+    for l in "12":
+        f1 = fields(tmp_path / ("one" + l))
+        assert np.ptp(f1["a"]) > 1e-3
+        for s in "ab":
+            assert np.array_equal(f1[s], f2[s + l]), (l, s, np.max(np.abs(f1[s] - f2[s + l])))

@@ -130,6 +130,18 @@ TEST(LayeredModel, NamesRatesJacobianAndSteadyState) {
     EXPECT_NEAR(x, 0.0, 1e-13);
   EXPECT_FALSE(m.steady_state(p.data(), us.data()));
   EXPECT_THROW(layered_model(brusselator(), 17), UserError);
+  // The composite Jacobian against central differences of the composite rates.
+  std::vector<double> x = u, rp(6), rm(6);
+  for (int q = 0; q < 6; ++q) {
+    const double h = 1e-6 * (1 + std::fabs(u[q]));
+    x[q] = u[q] + h;
+    m.rates(x.data(), p.data(), rp.data());
+    x[q] = u[q] - h;
+    m.rates(x.data(), p.data(), rm.data());
+    x[q] = u[q];
+    for (int s = 0; s < 6; ++s)
+      EXPECT_NEAR(J[s * 6 + q], (rp[s] - rm[s]) / (2 * h), 1e-6 * (1 + std::fabs(J[s * 6 + q])));
+  }
 }
 
 // The runtime kernels against the compiled Brusselator's, on one row of 7 cells.
