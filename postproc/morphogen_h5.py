@@ -14,9 +14,13 @@ As a module (h5py; do not import it in a ParaView/VTK process, see README "Outpu
     ck = mh.read_checkpoint("run/checkpoint_0001000.vtkhdf")   # + ck["attrs"] (all of /morphogen)
 
 spacing and origin are tuples in x, y[, z] order with one entry per grid dimension (2 or 3);
-the cell centre of index i along x is origin[0] + i * spacing[0] (= (i + 0.5) h). "extent" is the
-file's WholeExtent (6 integers, z range 0..0 in 2-D). Any unreadable, truncated or malformed
-file raises MorphogenH5Error (a ValueError) naming the file and the reason; read_checkpoint also
+the cell centre of index i along x is origin[0] + i * spacing[0] (= (i + 0.5) h), whatever the
+file's layout; bounds is ((x0, x1), (y0, y1)[, (z0, z1)]), the domain (0 .. n h). Snapshots store
+the cells as /VTKHDF/PointData on the cell centres (WholeExtent 0..n-1 per axis, z 0..0 in 2-D,
+Origin h/2); files of the CellData layout (an image of the cell corners: WholeExtent 0..n, z
+0..0 in 2-D, Origin 0), written by an intermediate development version, are read too; "layout"
+says which ("PointData" or "CellData"). "extent" is the file's WholeExtent (6 integers). Any
+unreadable, truncated or malformed file raises MorphogenH5Error (a ValueError) naming the file and the reason; read_checkpoint also
 refuses a checkpoint without complete = 1 (an interrupted write).
 
 The command line prints a summary of each file (a snapshot or checkpoint: model, step, time,
@@ -81,7 +85,8 @@ def _open(path):
 
 
 def _layout(f, path):
-    """Validate /VTKHDF and return (extent, origin3, spacing3, species list)."""
+    """Validate /VTKHDF and return (extent, cells (nz, ny, nx), origin3 (first cell centre),
+    spacing3, group ("PointData", or "CellData" in files of that layout), species list)."""
     if "VTKHDF" not in f:
         _fail(path, "no /VTKHDF group (not a VTKHDF file)")
     g = f["VTKHDF"]
@@ -100,20 +105,26 @@ def _layout(f, path):
     if len(extent) != 6 or len(origin) != 3 or len(spacing) != 3:
         _fail(path, f"WholeExtent/Origin/Spacing have {len(extent)}/{len(origin)}/{len(spacing)} "
                     "values, expected 6/3/3")
-    shape = tuple(extent[2 * a + 1] - extent[2 * a] + 1 for a in (2, 1, 0))  # (nz, ny, nx)
-    if min(shape) < 1:
+    group = "PointData" if "PointData" in g or "CellData" not in g else "CellData"
+    spans = [extent[2 * a + 1] - extent[2 * a] for a in (2, 1, 0)]
+    if min(spans) < 0:
         _fail(path, f"empty WholeExtent {extent}")
-    if "PointData" not in g or not len(g["PointData"]):
-        _fail(path, "no datasets in /VTKHDF/PointData")
-    species = list(g["PointData"].keys())
+    if group == "PointData":  # one point per cell, at its centre
+        shape = tuple(s + 1 for s in spans)  # (nz, ny, nx)
+    else:  # CellData: points at the cell corners; a flat axis (0..0) holds one layer of cells
+        shape = tuple(max(s, 1) for s in spans)
+        origin = [o + h / 2 if s > 0 else o for o, h, s in zip(origin, spacing, spans[::-1])]
+    if group not in g or not len(g[group]):
+        _fail(path, f"no datasets in /VTKHDF/{group}")
+    species = list(g[group].keys())
     for name in species:
-        ds = g["PointData"][name]
+        ds = g[group][name]
         if not isinstance(ds, h5py.Dataset):
-            _fail(path, f"/VTKHDF/PointData/{name} is not a dataset")
+            _fail(path, f"/VTKHDF/{group}/{name} is not a dataset")
         if tuple(ds.shape) != shape:
-            _fail(path, f"/VTKHDF/PointData/{name} has shape {tuple(ds.shape)}, WholeExtent "
+            _fail(path, f"/VTKHDF/{group}/{name} has shape {tuple(ds.shape)}, WholeExtent "
                         f"{extent} needs (nz, ny, nx) = {shape}")
-    return extent, origin, spacing, species
+    return extent, shape, origin, spacing, group, species
 
 
 def _attrs(f):
@@ -125,13 +136,12 @@ def _attrs(f):
 def _read(path, with_fields=True):
     with _open(path) as f:
         try:
-            extent, origin3, spacing3, species = _layout(f, path)
+            extent, cells, origin3, spacing3, group, species = _layout(f, path)
             attrs = _attrs(f)
-            nz = extent[5] - extent[4] + 1
-            dim = 2 if nz == 1 else 3
+            dim = 2 if cells[0] == 1 else 3
             fields, dtypes = {}, {}
             for name in species:
-                ds = f["VTKHDF"]["PointData"][name]
+                ds = f["VTKHDF"][group][name]
                 dtypes[name] = ds.dtype.name
                 if with_fields:
                     data = ds[()]
@@ -146,8 +156,11 @@ def _read(path, with_fields=True):
         "step": int(attrs["step"]) if "step" in attrs else None,
         "model": attrs.get("model"),
         "dim": dim,
-        "shape": tuple(extent[2 * a + 1] - extent[2 * a] + 1 for a in range(dim)),  # nx, ny[, nz]
+        "shape": tuple(cells[::-1][:dim]),  # nx, ny[, nz]
         "extent": extent,
+        "layout": group,
+        "bounds": tuple((origin3[a] - spacing3[a] / 2, origin3[a] + (cells[2 - a] - 0.5) * spacing3[a])
+                        for a in range(dim)),
         "origin": tuple(origin3[:dim]),
         "spacing": tuple(spacing3[:dim]),
         "origin3": tuple(origin3),
@@ -165,8 +178,10 @@ def read_snapshot(path):
     """A snapshot (or checkpoint) file -> dict(time, step, model, spacing, origin, fields, ...).
 
     fields maps species -> ndarray of shape (ny, nx) in 2-D, (nz, ny, nx) in 3-D, in the file's
-    precision. Also: dim, shape (nx, ny[, nz]), extent, origin3/spacing3 (the three-component
-    file attributes), species (file order), dtypes, attrs (all /morphogen attributes), path."""
+    precision. Also: dim, shape (nx, ny[, nz]), extent (the file's WholeExtent), layout
+    ("PointData", or "CellData" for files of that layout), bounds (the domain per axis),
+    origin3/spacing3 (three components: the first cell centre, z = 0 in 2-D, and the file's
+    Spacing), species (file order), dtypes, attrs (all /morphogen attributes), path."""
     return _read(path)
 
 
@@ -256,9 +271,10 @@ def _summary(path):
 
 
 def _jsonable(d):
-    keep = ("path", "time", "step", "model", "dim", "shape", "extent", "origin", "spacing",
+    keep = ("path", "time", "step", "model", "dim", "shape", "extent", "layout", "bounds", "origin",
+            "spacing",
             "origin3", "spacing3", "species", "dtypes")
-    return {k: (list(d[k]) if isinstance(d[k], tuple) else d[k]) for k in keep}
+    return {k: (json.loads(json.dumps(d[k])) if isinstance(d[k], tuple) else d[k]) for k in keep}
 
 
 def main(argv=None):

@@ -212,7 +212,8 @@ def read_field(path, species):
         import h5py
 
         with h5py.File(path, "r") as f:
-            pd = f["VTKHDF"]["PointData"]
+            g = f["VTKHDF"]
+            pd = g["PointData"] if "PointData" in g else g["CellData"]  # either layout
             if species is None:
                 species = sorted(pd.keys())[0]
             if species not in pd:

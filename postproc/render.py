@@ -29,9 +29,10 @@ display: it draws the plane (2-D) or the z slice (3-D) cell by cell with matplot
 --backend auto (default) uses gl when $DISPLAY is set (and a local display's socket exists),
 image otherwise.
 
-Data are read through the XDMF reader only (ParaView 5.11's VTKHDF reader crashes on 2-D image
-data), by absolute path (5.11 mis-joins data paths for a bare relative .xmf name). Errors: one
-line on stderr, exit status 1.
+Data are read through the XDMF3 reader only, as cell data with bounds = the domain (ParaView
+5.11's VTKHDF reader crashes on 2-D image data; the older XDMF reader reads no cell data of 2-D
+images), by absolute path (5.11 mis-joins data paths for a bare relative .xmf name). Errors:
+one line on stderr, exit status 1.
 """
 import argparse
 import os
@@ -40,7 +41,7 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from vtkhdf_to_vti import InputError, read_xdmf, resolve_input  # noqa: E402
+from vtkhdf_to_vti import InputError, image_cells, read_xdmf, resolve_input  # noqa: E402
 
 PROG = "render"
 MPL_NAMES = {"viridis (matplotlib)": "viridis", "inferno (matplotlib)": "inferno",
@@ -130,19 +131,25 @@ def time_label(t):
 def render_gl(args, xmf, entries, dim, species, paths):
     from paraview import simple
 
-    reader = simple.XDMFReader(FileNames=[xmf])
-    reader.PointArrayStatus = [species]
+    # XDMF3: the older XDMF reader reads no cell data of 2-D (flat) images.
+    reader = simple.Xdmf3ReaderS(FileName=[xmf])
     times = list(reader.TimestepValues) if len(entries) > 1 else [None]
     if len(times) == 1 and times[0] is None and len(entries) > 1:
         raise InputError(f"{xmf}: no time steps")
     chosen = [times[i] if i < len(times) else None for i in args.frames]
+    if chosen[0] is None:
+        reader.UpdatePipeline()
+    else:
+        reader.UpdatePipeline(chosen[0])
+    # cell data (an image of the cell corners); an .xmf of an earlier version: point data
+    cells = species in reader.CellData.keys()
 
     def data_range(t):
         if t is None:
             reader.UpdatePipeline()
         else:
             reader.UpdatePipeline(t)
-        return reader.PointData[species].GetRange()
+        return (reader.CellData if cells else reader.PointData)[species].GetRange()
 
     if args.crange == "all":
         rs = [data_range(t) for t in chosen]
@@ -154,13 +161,16 @@ def render_gl(args, xmf, entries, dim, species, paths):
 
     view = simple.CreateRenderView()
     try:
-        _draw_gl(args, simple, reader, view, entries, dim, species, paths, chosen, crange, data_range)
+        _draw_gl(args, simple, reader, cells, view, entries, dim, species, paths, chosen, crange,
+                 data_range)
     finally:
         # Without this, Python's exit tears the GL context down first: X error, exit status 1.
         simple.Delete(view)
 
 
-def _draw_gl(args, simple, reader, view, entries, dim, species, paths, chosen, crange, data_range):
+def _draw_gl(args, simple, reader, cells, view, entries, dim, species, paths, chosen, crange,
+             data_range):
+    """cells: the species is cell data (an image of the cell corners), else point data."""
     view.ViewSize = list(args.size)
     view.OrientationAxesVisibility = 0
     view.UseColorPaletteForBackground = 0
@@ -190,23 +200,24 @@ def _draw_gl(args, simple, reader, view, entries, dim, species, paths, chosen, c
         if args.mode == "slice":
             ext = info.GetExtent()
             z = args.slice_at
-            if z is None:
+            if z is None:  # the middle layer's centre (cells), the middle point layer (points)
                 nz = ext[5] - ext[4] + 1
                 hz = (b[5] - b[4]) / (nz - 1) if nz > 1 else 0.0
-                z = b[4] + (nz // 2) * hz
+                z = b[4] + ((nz - 1) // 2 + 0.5) * hz if cells else b[4] + (nz // 2) * hz
             sl = simple.Slice(Input=reader)
             sl.SliceType = "Plane"
             sl.SliceType.Origin = [center[0], center[1], z]
             sl.SliceType.Normal = [0, 0, 1]
             colored = simple.Show(sl, view)
-        elif args.mode == "volume":
-            colored = simple.Show(reader, view)
+        elif args.mode == "volume":  # point data: 5.11's volume mappers, contours need it
+            colored = simple.Show(simple.CellDatatoPointData(Input=reader) if cells else reader, view)
             colored.SetRepresentationType("Volume")
         else:
             iso = args.iso
             if iso is None:
                 iso = 0.5 * (crange[0] + crange[1])
-            ct = simple.Contour(Input=reader, ContourBy=["POINTS", species], Isosurfaces=[iso])
+            src = simple.CellDatatoPointData(Input=reader) if cells else reader
+            ct = simple.Contour(Input=src, ContourBy=["POINTS", species], Isosurfaces=[iso])
             cd = simple.Show(ct, view)
             cd.ColorArrayName = ["POINTS", ""]
             cd.DiffuseColor = cd.AmbientColor = args.iso_color
@@ -214,7 +225,8 @@ def _draw_gl(args, simple, reader, view, entries, dim, species, paths, chosen, c
         view.CameraPosition = [center[0] + 1.6 * size, center[1] - 2.2 * size, center[2] + 1.9 * size]
         view.CameraViewUp = [0, 0, 1]
     if colored is not None:
-        simple.ColorBy(colored, ("POINTS", species))
+        point_input = not cells or (args.mode == "volume" and dim == 3)
+        simple.ColorBy(colored, ("POINTS" if point_input else "CELLS", species))
         colored.LookupTable = lut
         if args.mode == "volume" and dim == 3:
             colored.ScalarOpacityFunction = pwf
@@ -282,9 +294,8 @@ def render_image(args, xmf, entries, dim, species, paths):
         for i, (entry, image) in enumerate(read_xdmf(xmf, entries)):
             if i not in wanted:
                 continue
-            nx, ny, nz = image.GetDimensions()
-            o, h = image.GetOrigin(), image.GetSpacing()
-            values = vtk_to_numpy(image.GetPointData().GetArray(species)).reshape(nz, ny, nx)
+            pd, (nx, ny, nz), o, h = image_cells(image)  # o: the first cell centre
+            values = vtk_to_numpy(pd.GetArray(species)).reshape(nz, ny, nx)
             k = 0
             if dim == 3:
                 k = nz // 2 if args.slice_at is None else int(round((args.slice_at - o[2]) / h[2]))

@@ -46,7 +46,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from render import MPL_NAMES, display_works, time_label  # noqa: E402
-from vtkhdf_to_vti import InputError, read_xdmf, resolve_input  # noqa: E402
+from vtkhdf_to_vti import InputError, image_cells, read_xdmf, resolve_input  # noqa: E402
 
 PROG = "render_surface"
 
@@ -271,12 +271,11 @@ def load_plane(args, tmp):
     from vtkmodules.util.numpy_support import vtk_to_numpy
 
     for e, image in read_xdmf(xmf, entries):
-        nx, ny, nz = image.GetDimensions()
+        pd, (nx, ny, nz), o, h = image_cells(image)  # o: the first cell centre
         if nz != 1:
             raise InputError(f"{e['file']}: a 3-D snapshot ({nx}x{ny}x{nz}); render_surface maps "
                              "2-D runs only")
-        o, h = image.GetOrigin(), image.GetSpacing()
-        values = vtk_to_numpy(image.GetPointData().GetArray(species)).reshape(ny, nx).astype(float)
+        values = vtk_to_numpy(pd.GetArray(species)).reshape(ny, nx).astype(float)
         return dict(species=species, values=values, u=o[0] + h[0] * np.arange(nx),
                     v=o[1] + h[1] * np.arange(ny), Lx=nx * h[0], Ly=ny * h[1],
                     time=entry["time"], name=run_name)

@@ -9,13 +9,16 @@ For tools that read neither VTKHDF nor XDMF (older ParaView/VisIt, VTK readers, 
 INPUT is a run directory (its NAME.xmf), a NAME.xmf, a NAME.vtkhdf.series, or one or more
 snapshot/checkpoint .vtkhdf files. Writes DIR/<snapshot name>.vti per output time (binary,
 zlib-compressed, the file's precision; field data TimeValue and Step) and DIR/NAME.pvd
-listing them with their times (DIR defaults to RUN_DIR/vti). 2-D runs give one-cell-thick
-images (z extent 0..0), 3-D runs full volumes; origin and spacing are the cell-centred grid's.
+listing them with their times (DIR defaults to RUN_DIR/vti). The fields are cell data of an
+image of the cell corners, so the bounds are the domain (0 .. n h), as in the run's .xmf; 2-D
+runs give flat images (z extent 0..0), 3-D runs full volumes. Snapshots of either layout
+(/VTKHDF/PointData on the cell centres, or the CellData layout) convert alike; an .xmf of an
+earlier version (Center="Node") converts as point data on the cell centres.
 
 Runs in ParaView's Python (the project's VTK, Debian's python3-paraview); plain `pvpython` needs
---no-mpi. Everything is read through VTK's XDMF reader: ParaView 5.11's VTKHDF reader crashes on
-2-D image data. A .series or a list of .vtkhdf files is first described in a temporary XDMF file
-(absolute data paths, so 5.11's relative-path mis-join cannot occur), using the metadata that
+--no-mpi. Everything is read through VTK's XDMF3 reader: ParaView 5.11's VTKHDF reader crashes
+on 2-D image data. A .series or a list of .vtkhdf files is first described in a temporary XDMF
+file (absolute data paths, so 5.11's relative-path mis-join cannot occur), using the metadata that
 postproc/morphogen_h5.py --json prints; that runs in a separate /usr/bin/python3 (h5py) process
 ($MORPHOGEN_PYTHON overrides), because h5py and ParaView's VTK load different HDF5 libraries.
 render.py uses resolve_input() from here. Errors: one line on stderr, exit status 1.
@@ -97,16 +100,21 @@ def check_files(index, files):
 
 
 def write_xdmf(metas, times, path):
-    """An XDMF 3 temporal collection over VTKHDF files (absolute paths), as morphogen writes."""
+    """An XDMF 3 temporal collection over VTKHDF files (absolute paths), as morphogen writes:
+    an image of the cell corners (n + 1 points per axis, 1 along a flat z) from the domain's
+    corner, the species as its cell data, whichever group of the file holds them."""
     out = ['<?xml version="1.0" ?>', '<Xdmf Version="3.0">', ' <Domain>',
            '  <Grid Name="morphogen" GridType="Collection" CollectionType="Temporal">']
     for m, t in zip(metas, times):
-        nx, ny, nz = (m["extent"][2 * a + 1] - m["extent"][2 * a] + 1 for a in range(3))
+        group = m.get("layout", "PointData")  # "CellData" in files of that layout
+        nx, ny, nz = (list(m["shape"]) + [1])[:3]
         dims = f"{nz} {ny} {nx}"
-        o, h = m["origin3"], m["spacing3"]
+        mesh = f"{nz + 1 if nz > 1 else 1} {ny + 1} {nx + 1}"
+        h = m["spacing3"]  # origin3: the first cell centre, whatever the layout
+        o = [m["origin3"][a] - h[a] / 2 if a < m["dim"] else m["origin3"][a] for a in range(3)]
         out.append(f'   <Grid Name="{os.path.basename(m["path"])}" GridType="Uniform">')
         out.append(f'    <Time Value="{t!r}"/>')
-        out.append(f'    <Topology TopologyType="3DCoRectMesh" Dimensions="{dims}"/>')
+        out.append(f'    <Topology TopologyType="3DCoRectMesh" Dimensions="{mesh}"/>')
         out.append('    <Geometry GeometryType="ORIGIN_DXDYDZ">')
         out.append('     <DataItem Dimensions="3" NumberType="Float" Precision="8" Format="XML">'
                    f'{o[2]!r} {o[1]!r} {o[0]!r}</DataItem>')
@@ -115,9 +123,9 @@ def write_xdmf(metas, times, path):
         out.append('    </Geometry>')
         for s in m["species"]:
             prec = 8 if m["dtypes"][s] == "float64" else 4
-            out.append(f'    <Attribute Name="{s}" AttributeType="Scalar" Center="Node">')
+            out.append(f'    <Attribute Name="{s}" AttributeType="Scalar" Center="Cell">')
             out.append(f'     <DataItem Dimensions="{dims}" NumberType="Float" Precision="{prec}" '
-                       f'Format="HDF">{m["path"]}:/VTKHDF/PointData/{s}</DataItem>')
+                       f'Format="HDF">{m["path"]}:/VTKHDF/{group}/{s}</DataItem>')
             out.append('    </Attribute>')
         out.append('   </Grid>')
     out += ['  </Grid>', ' </Domain>', '</Xdmf>', '']
@@ -199,6 +207,19 @@ def resolve_input(paths, tmpdir, name=None):
 
 # ---------------------------------------------------------------- reading and writing with VTK
 
+def image_cells(image):
+    """(attributes, (nx, ny, nz), first cell centre (x, y, z), spacing) of an image read from a
+    morphogen file: its cell data (an image of the cell corners, as morphogen's .xmf describes
+    either file layout) or, through an .xmf of an earlier version, its point data (one point
+    per cell, at the centre). Values are x fastest."""
+    dims, o, h = image.GetDimensions(), image.GetOrigin(), image.GetSpacing()
+    cd = image.GetCellData()
+    if cd.GetNumberOfArrays() > 0:
+        n = tuple(d - 1 if d > 1 else 1 for d in dims)
+        return cd, n, tuple(o[a] + h[a] / 2 if dims[a] > 1 else o[a] for a in range(3)), h
+    return image.GetPointData(), tuple(dims), tuple(o), h
+
+
 def read_xdmf(xmf, entries, verbose=False):
     """Yield (entry, vtkImageData) per time of an XDMF temporal index (absolute path)."""
     from vtkmodules.vtkCommonCore import vtkObject
@@ -227,10 +248,10 @@ def read_xdmf(xmf, entries, verbose=False):
             raise InputError(f"{xmf}: time {entry['time']!r}: read {kind}, expected image data")
         image = vtkImageData()
         image.DeepCopy(out)
-        pd = image.GetPointData()
+        pd, n, _, _ = image_cells(image)
         for s in entry["species"]:
             arr = pd.GetArray(s)
-            if arr is None or arr.GetNumberOfTuples() != image.GetNumberOfPoints():
+            if arr is None or arr.GetNumberOfTuples() != n[0] * n[1] * n[2]:
                 raise InputError(f"{entry['file']}: species {s} could not be read (missing, "
                                  "truncated or unreadable file)")
         yield entry, image
@@ -261,7 +282,7 @@ def convert(inputs, out_dir=None, name=None, species=None, verbose=False):
         os.makedirs(out_dir, exist_ok=True)
         written, items = [], []
         for entry, image in read_xdmf(xmf, entries, verbose):
-            pd = image.GetPointData()
+            pd = image_cells(image)[0]
             if species:
                 unknown = [s for s in species if pd.GetArray(s) is None]
                 if unknown:

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -27,27 +28,42 @@ long long step_of(const std::string& file, const std::string& name) {
   return std::stoll(digits);
 }
 
+// One grid of the temporal collection: a 3DCoRectMesh of the cell corners (n + 1 points per
+// axis, 1 along z in 2-D: VTK's flat image of nx x ny cells) from the domain's corner, whose
+// Center="Cell" attributes are the file's datasets, so the bounds are the domain. Either layout
+// holds one value per cell: PointData (the cell centres, Origin h/2) or CellData (the cell
+// corners, Origin 0).
 std::string xmf_grid(const SeriesEntry& e) {
   const auto& n = e.info.n;
-  const std::string dims =
+  const bool flat_z = n[2] == 1; // 2-D (a 3-D grid has >= 3 cells per axis)
+  std::array<long long, 3> points{};
+  std::array<double, 3> origin{};
+  for (int d = 0; d < 3; ++d) {
+    const bool flat = d == 2 && flat_z;
+    points[d] = flat ? 1 : n[d] + 1;
+    origin[d] = e.info.origin[d] - (e.info.cell_data || flat ? 0.0 : 0.5 * e.info.spacing[d]);
+  }
+  const std::string mesh =
+      std::to_string(points[2]) + " " + std::to_string(points[1]) + " " + std::to_string(points[0]);
+  const std::string data =
       std::to_string(n[2]) + " " + std::to_string(n[1]) + " " + std::to_string(n[0]);
   std::ostringstream x;
   x << "   <Grid Name=\"step_" << e.step << "\" GridType=\"Uniform\">\n"
     << "    <Time Value=\"" << format_double(e.time) << "\"/>\n"
-    << "    <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"" << dims << "\"/>\n"
+    << "    <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"" << mesh << "\"/>\n"
     << "    <Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n"
     << "     <DataItem Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" Format=\"XML\">"
-    << format_double(e.info.origin[2]) << " " << format_double(e.info.origin[1]) << " "
-    << format_double(e.info.origin[0]) << "</DataItem>\n"
+    << format_double(origin[2]) << " " << format_double(origin[1]) << " "
+    << format_double(origin[0]) << "</DataItem>\n"
     << "     <DataItem Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" Format=\"XML\">"
     << format_double(e.info.spacing[2]) << " " << format_double(e.info.spacing[1]) << " "
     << format_double(e.info.spacing[0]) << "</DataItem>\n"
     << "    </Geometry>\n";
   for (const auto& a : e.info.arrays)
-    x << "    <Attribute Name=\"" << a << "\" AttributeType=\"Scalar\" Center=\"Node\">\n"
-      << "     <DataItem Dimensions=\"" << dims << "\" NumberType=\"Float\" Precision=\""
-      << e.info.precision << "\" Format=\"HDF\">" << e.file << ":/VTKHDF/PointData/" << a
-      << "</DataItem>\n"
+    x << "    <Attribute Name=\"" << a << "\" AttributeType=\"Scalar\" Center=\"Cell\">\n"
+      << "     <DataItem Dimensions=\"" << data << "\" NumberType=\"Float\" Precision=\""
+      << e.info.precision << "\" Format=\"HDF\">" << e.file << ":/VTKHDF/" << e.info.group() << "/"
+      << a << "</DataItem>\n"
       << "    </Attribute>\n";
   x << "   </Grid>\n";
   return x.str();

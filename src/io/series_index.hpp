@@ -3,10 +3,13 @@
 //
 //   <name>.vtkhdf.series  JSON {"file-series-version": "1.0", "files": [{"name", "time"}...]},
 //                         ParaView's file-series reader over the VTKHDF files;
-//   <name>.xmf            XDMF 3 temporal collection of 3DCoRectMesh grids (Dimensions
-//                         "nz ny nx", nz = 1 in 2-D) whose attributes point at the same HDF5
-//                         datasets (<file>:/VTKHDF/PointData/<species>). ParaView 5.11 opens
-//                         2-D runs through this index (its VTKHDF reader crashes on 2-D).
+//   <name>.xmf            XDMF 3 temporal collection of 3DCoRectMesh grids of the cell
+//                         corners (Dimensions "nz+1 ny+1 nx+1", "1 ny+1 nx+1" in 2-D; origin 0,
+//                         spacing h) whose Center="Cell" attributes point at the same HDF5
+//                         datasets (<file>:/VTKHDF/PointData/<species>, shape "nz ny nx";
+//                         files of the CellData layout: /VTKHDF/CellData/<species>). The values
+//                         are cell data and the bounds are the domain, [0, n h] per axis (the
+//                         .vtkhdf files themselves show them as points at the cell centres).
 //
 // Entries are keyed by step: re-adding a step replaces it, and a restart from step S drops the
 // entries after S, so the series never holds duplicates.

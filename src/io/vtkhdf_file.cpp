@@ -174,6 +174,7 @@ std::string ImageInfo::to_json() const {
   j["n"] = n;
   j["origin"] = origin;
   j["spacing"] = spacing;
+  j["cell_data"] = cell_data;
   j["arrays"] = arrays;
   j["precision"] = precision;
   j["reals"] = attributes.reals;
@@ -188,6 +189,7 @@ ImageInfo ImageInfo::from_json(const std::string& text) {
   info.n = j["n"].get<std::array<long long, 3>>();
   info.origin = j["origin"].get<std::array<double, 3>>();
   info.spacing = j["spacing"].get<std::array<double, 3>>();
+  info.cell_data = j["cell_data"].get<bool>();
   info.arrays = j["arrays"].get<std::vector<std::string>>();
   info.precision = j["precision"].get<int>();
   info.attributes.reals = j["reals"].get<std::vector<std::pair<std::string, double>>>();
@@ -224,10 +226,18 @@ std::optional<ImageInfo> inspect_vtkhdf(const std::string& path, std::string& wh
     why = "/VTKHDF is not ImageData with WholeExtent, Origin and Spacing";
     return std::nullopt;
   }
-  for (int d = 0; d < 3; ++d)
-    info.n[d] = extent[2 * d + 1] - extent[2 * d] + 1;
-  if (H5Lexists(vtk, "PointData", H5P_DEFAULT) > 0) {
-    H5Id pd(H5Gopen2(vtk, "PointData", H5P_DEFAULT), H5Gclose);
+  // PointData (the layout written): one point per cell, at its centre. CellData (written by an
+  // intermediate development version): WholeExtent counts the cell corners (cells + 1; a flat axis
+  // 0..0 holds one layer of cells).
+  info.cell_data =
+      H5Lexists(vtk, "PointData", H5P_DEFAULT) <= 0 && H5Lexists(vtk, "CellData", H5P_DEFAULT) > 0;
+  for (int d = 0; d < 3; ++d) {
+    const long long span = extent[2 * d + 1] - extent[2 * d];
+    info.n[d] = info.cell_data ? (span == 0 ? 1 : span) : span + 1;
+  }
+  const std::string group = info.group();
+  if (H5Lexists(vtk, group.c_str(), H5P_DEFAULT) > 0) {
+    H5Id pd(H5Gopen2(vtk, group.c_str(), H5P_DEFAULT), H5Gclose);
     if (pd.ok()) H5Literate(pd, H5_INDEX_NAME, H5_ITER_INC, nullptr, collect_dataset, &info.arrays);
     for (size_t a = 0; a < info.arrays.size(); ++a) {
       H5Id ds(H5Dopen2(pd, info.arrays[a].c_str(), H5P_DEFAULT), H5Dclose);
@@ -238,7 +248,7 @@ std::optional<ImageInfo> inspect_vtkhdf(const std::string& path, std::string& wh
           static_cast<long long>(dims[0]) != info.n[2] ||
           static_cast<long long>(dims[1]) != info.n[1] ||
           static_cast<long long>(dims[2]) != info.n[0]) {
-        why = "dataset /VTKHDF/PointData/" + info.arrays[a] + " does not match WholeExtent";
+        why = "dataset /VTKHDF/" + group + "/" + info.arrays[a] + " does not match WholeExtent";
         return std::nullopt;
       }
       if (a == 0) {
@@ -317,7 +327,7 @@ PetscErrorCode VtkHdfIO::write_impl(const std::string& path, const std::vector<s
   int extent[6] = {0, 0, 0, 0, 0, 0};
   double origin[3] = {0, 0, 0}, spacing[3] = {sp.h(0), sp.h(1), sp.h(0)};
   const double direction[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-  for (int d = 0; d < grid_.dim(); ++d) {
+  for (int d = 0; d < grid_.dim(); ++d) { // one point per cell, at its centre
     extent[2 * d + 1] = static_cast<int>(sp.n[d] - 1);
     origin[d] = 0.5 * sp.h(d);
     spacing[d] = sp.h(d);
@@ -348,7 +358,13 @@ PetscErrorCode VtkHdfIO::read_impl(const std::string& path, const std::vector<st
   PetscViewer v;
   PetscCall(PetscViewerHDF5Open(grid_.comm(), path.c_str(), FILE_MODE_READ, &v));
   PetscCall(PetscViewerHDF5SetCollective(v, PETSC_TRUE));
-  PetscCall(PetscViewerHDF5PushGroup(v, "/VTKHDF/PointData"));
+  // PointData, or CellData in files of an intermediate development version (every rank reads the
+  // links, so all take the same branch; the datasets have the same shape in both layouts).
+  hid_t file;
+  PetscCall(PetscViewerHDF5GetFileId(v, &file));
+  const htri_t points = H5Lexists(file, "/VTKHDF/PointData", H5P_DEFAULT);
+  const htri_t cells = points > 0 ? 0 : H5Lexists(file, "/VTKHDF/CellData", H5P_DEFAULT);
+  PetscCall(PetscViewerHDF5PushGroup(v, cells > 0 ? "/VTKHDF/CellData" : "/VTKHDF/PointData"));
   for (size_t s = 0; s < fields.size(); ++s) {
     PetscCall(PetscObjectSetName(reinterpret_cast<PetscObject>(io_.get()), names[s].c_str()));
     PetscCall(VecLoad(io_, v));

@@ -1,17 +1,22 @@
 // VTKHDF ImageData files: the snapshot and checkpoint format ParaView opens without a plug-in.
 //
 //   /VTKHDF                 attributes Version int32[2] = {1,0}, Type = "ImageData",
-//                           WholeExtent int32[6] = {0,nx-1, 0,ny-1, 0,nz-1}, Origin double[3]
-//                           (the first cell centre, h/2 per axis), Spacing double[3],
-//                           Direction double[9] (identity)
+//                           WholeExtent int32[6] = {0,nx-1, 0,ny-1, 0,nz-1} ({.., 0,0} in 2-D),
+//                           Origin double[3] (the first cell centre, h/2 per axis; z = 0 in
+//                           2-D), Spacing double[3] = h, Direction double[9] (identity)
 //   /VTKHDF/PointData/<s>   one dataset per species, shape (nz, ny, nx) -- always three
 //                           dimensions, nz = 1 for 2-D runs -- float32 or float64
 //   /morphogen              attributes (time, step, model, ... for checkpoints: see checkpoint.hpp)
 //
-// Cell-centred values are stored as VTK points at the cell centres. Fields are written and read
-// collectively by PETSc's HDF5 viewer (MPI-IO hyperslabs, never gathered on one rank) through a
-// 3-D DMDA with the run's ownership ranges (2-D grids get nz = 1), so a file written on any
-// number of ranks loads on any other.
+// Cell-centred values are stored as VTK points at the cell centres, the layout every VTKHDF
+// reader opens (ParaView 5.11's reads no image cell data), so a .vtkhdf file's bounds are the
+// cell centres, h/2 .. (n - 1/2) h; the .xmf index (series_index.hpp) presents the same datasets
+// as cell data with bounds = the domain. Files of an earlier development version stored them as
+// /VTKHDF/CellData/<s> of an image of the cell corners (WholeExtent {0,nx, 0,ny, 0,nz}, z 0..0 in
+// 2-D, Origin 0): they are still read (inspect_vtkhdf and VtkHdfIO::read accept both layouts).
+// Fields are written and read collectively by PETSc's HDF5 viewer (MPI-IO hyperslabs, never
+// gathered on one rank) through a 3-D DMDA with the run's ownership ranges (2-D grids get
+// nz = 1), so a file written on any number of ranks loads on any other.
 #pragma once
 
 #include "grid/grid.hpp"
@@ -35,11 +40,13 @@ struct H5Attributes {
 
 // What a file holds, read without PETSc (one rank).
 struct ImageInfo {
-  std::array<long long, 3> n{1, 1, 1};
-  std::array<double, 3> origin{0, 0, 0}, spacing{1, 1, 1};
-  std::vector<std::string> arrays; // /VTKHDF/PointData datasets
+  std::array<long long, 3> n{1, 1, 1};                     // cells per axis (1 along z in 2-D)
+  std::array<double, 3> origin{0, 0, 0}, spacing{1, 1, 1}; // the file's Origin and Spacing
+  bool cell_data = false;          // false: /VTKHDF/PointData; true: the CellData layout
+  std::vector<std::string> arrays; // datasets of /VTKHDF/PointData (or CellData)
   int precision = 8;               // bytes per value of the first array
   H5Attributes attributes;         // /morphogen, if present
+  const char* group() const { return cell_data ? "CellData" : "PointData"; }
   std::string to_json() const;
   static ImageInfo from_json(const std::string& text);
 };
@@ -61,7 +68,8 @@ public:
                     const H5Attributes& attributes) const;
 
   // Collective. Reads the datasets `names` into the owned cells of the ghosted local vectors
-  // (ghosts are not updated). The file's extents must match the grid. Returns "" or a message.
+  // (ghosts are not updated), from /VTKHDF/PointData or, in files of the CellData layout,
+  // /VTKHDF/CellData. The file's extents must match the grid. Returns "" or a message.
   std::string read(const std::string& path, const std::vector<std::string>& names,
                    const std::vector<Vec>& fields) const;
 

@@ -8,8 +8,12 @@
   `latest` skips it with a warning;
 - a restart from an older checkpoint retires the newer ones and the series has no duplicates;
 - the NaN guard names the last good checkpoint; a read-only or full output directory fails
-  cleanly (exit 4, at start or mid-run) and leaves the previous checkpoint loadable.
-Fields are compared with h5py (the VTKHDF datasets /VTKHDF/PointData/<species>)."""
+  cleanly (exit 4, at start or mid-run) and leaves the previous checkpoint loadable;
+- snapshots hold /VTKHDF/PointData on the cell centres (WholeExtent 0..n-1, Origin h/2);
+  checkpoints of the CellData layout (an image of the cell corners: WholeExtent 0..n, Origin 0)
+  still restart, bitwise, and the series index then describes both layouts as cell data.
+Fields are compared with h5py (the VTKHDF datasets /VTKHDF/PointData/<species>, or CellData
+in files of that layout)."""
 import json
 import os
 import signal
@@ -28,7 +32,21 @@ SCHEMES = {"explicit": [], "split": ["-integrator", "split", "-dt", "2"]}
 
 def fields(path):
     with h5py.File(path, "r") as f:
-        return {k: f["VTKHDF/PointData"][k][...] for k in f["VTKHDF/PointData"]}
+        g = f["VTKHDF/PointData"] if "VTKHDF/PointData" in f else f["VTKHDF/CellData"]
+        return {k: g[k][...] for k in g}
+
+
+def to_celldata_layout(path):
+    """Rewrite a file in the CellData layout (as an intermediate development version wrote):
+    the cells as CellData of an image of the cell corners (WholeExtent 0..n, z 0..0 in 2-D,
+    Origin 0)."""
+    with h5py.File(path, "r+") as f:
+        g = f["VTKHDF"]
+        ext = [int(v) for v in g.attrs["WholeExtent"]]
+        g.move("PointData", "CellData")
+        g.attrs["WholeExtent"] = np.array([ext[2 * a + 1] + 1 if i and ext[2 * a + 1] > 0 else 0
+                                           for a in range(3) for i in (0, 1)], dtype=np.int32)
+        g.attrs["Origin"] = np.zeros(3)
 
 
 def attrs(path):
@@ -181,13 +199,20 @@ def test_snapshot_precision_and_layout(tmp_path):
     ok(run(["-grid_n", "12,10,8", "-steps", "4", "-png_every", "0", "-snapshot_precision",
             "float64", "-output_dir", "o"], tmp_path, 2))
     with h5py.File(tmp_path / "o/morphogen_0000004.vtkhdf", "r") as f:
+        assert "VTKHDF/CellData" not in f
         assert f["VTKHDF/PointData/a"].shape == (8, 10, 12)
         assert f["VTKHDF/PointData/a"].dtype == np.float64
-        assert list(f["VTKHDF"].attrs["WholeExtent"]) == [0, 11, 0, 9, 0, 7]
+        g = f["VTKHDF"]
+        assert list(g.attrs["WholeExtent"]) == [0, 11, 0, 9, 0, 7]
+        assert list(g.attrs["Origin"]) == [h / 2 for h in g.attrs["Spacing"]]  # the cell centres
     ok(run(["-grid_n", "12,10", "-steps", "4", "-png_every", "0", "-output_dir", "p"], tmp_path))
     with h5py.File(tmp_path / "p/morphogen_0000004.vtkhdf", "r") as f:
         assert f["VTKHDF/PointData/b"].shape == (1, 10, 12)
         assert f["VTKHDF/PointData/b"].dtype == np.float32
+        g = f["VTKHDF"]
+        assert list(g.attrs["WholeExtent"]) == [0, 11, 0, 9, 0, 0]
+        h = g.attrs["Spacing"]
+        assert list(g.attrs["Origin"]) == [h[0] / 2, h[1] / 2, 0]
 
 
 def can_mount(path, opts):
@@ -267,3 +292,43 @@ def test_mismatched_restart_is_refused_before_writing(tmp_path):
     assert r.returncode == 1 and "written by model turing" in error_line(r)
     assert (tmp_path / "o/options_used.yaml").read_text() == before
     assert (tmp_path / "o/checkpoint_0000020.vtkhdf").exists()  # not retired
+
+
+@pytest.mark.parametrize("grid,np_", [("48,40", 1), ("16,12,8", 2)])
+def test_celldata_layout_checkpoint_restarts(tmp_path, grid, np_):
+    """A checkpoint in the CellData layout (an image of the cell corners, as an intermediate
+    development version wrote) restarts bitwise, on another rank count too; the .xmf then lists
+    the CellData snapshots and the new PointData ones alike: cell data on the cell corners."""
+    opts = ["-grid_n", grid, "-png_every", "0", "-progress_every", "100000", "-snapshot_every",
+            "10"]
+    ok(run(opts + ["-steps", "20", "-output_dir", "straight"], tmp_path, np_))
+    ok(run(opts + ["-steps", "10", "-output_dir", "cells"], tmp_path, 3 - np_))
+    for p in (tmp_path / "cells").glob("*.vtkhdf"):
+        to_celldata_layout(p)
+    n = [int(v) for v in grid.split(",")]
+    with h5py.File(tmp_path / "cells/checkpoint_0000010.vtkhdf", "r") as f:
+        assert f["VTKHDF/CellData/a"].shape == tuple([1] * (3 - len(n)) + n[::-1])
+        assert "VTKHDF/PointData" not in f
+        assert list(f["VTKHDF"].attrs["WholeExtent"])[1::2] == (n + [0])[:3]
+    r = ok(run(opts + ["-steps", "20", "-output_dir", "cells", "-restart", "latest"], tmp_path,
+               np_))
+    assert "restart from cells/checkpoint_0000010.vtkhdf: step 10" in r.stdout
+    a = fields(tmp_path / "straight/checkpoint_0000020.vtkhdf")
+    b = fields(tmp_path / "cells/checkpoint_0000020.vtkhdf")
+    assert sorted(a) == ["a", "b"]
+    for s in a:
+        assert np.array_equal(a[s], b[s]), f"{s}: max diff {np.abs(a[s] - b[s]).max()}"
+    with h5py.File(tmp_path / "cells/checkpoint_0000020.vtkhdf", "r") as f:
+        assert "VTKHDF/PointData" in f and "VTKHDF/CellData" not in f  # written as usual
+    xmf = (tmp_path / "cells/morphogen.xmf").read_text()
+    assert xmf.count('Center="Cell"') == 6 and 'Center="Node"' not in xmf, xmf
+    assert "morphogen_0000010.vtkhdf:/VTKHDF/CellData/a" in xmf
+    assert "morphogen_0000020.vtkhdf:/VTKHDF/PointData/a" in xmf
+    mesh = " ".join(str(v) for v in reversed([v + 1 for v in n] + [1] * (3 - len(n))))
+    assert xmf.count(f'Dimensions="{mesh}"') == 3, xmf  # one mesh for both layouts
+    assert xmf.count(">0 0 0</DataItem>") == 3, xmf  # origin: the domain's corner
+    # a mismatched grid in the CellData layout is still refused with the cell counts
+    r = run(["-grid_n", "40,40", "-steps", "20", "-output_dir", "o2", "-restart",
+             str(tmp_path / "cells/checkpoint_0000010.vtkhdf")], tmp_path)
+    cells = (grid.split(",") + ["1"])[:3]
+    assert r.returncode == 1 and f"grid {'x'.join(cells)} with spacing" in error_line(r)

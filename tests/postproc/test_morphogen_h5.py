@@ -41,7 +41,8 @@ def runs(tmp_path_factory):
 
 
 def expected_geometry(r):
-    """(WholeExtent, Origin, Spacing, dataset shape) the format prescribes."""
+    """(WholeExtent, Origin, Spacing, dataset shape) the format prescribes: the cells are
+    PointData on the cell centres (n points per axis, z 0..0 in 2-D), Origin h/2."""
     n, h = r["n"], r["h"]
     if len(n) == 2:
         return ([0, n[0] - 1, 0, n[1] - 1, 0, 0], [h[0] / 2, h[1] / 2, 0.0], [h[0], h[1], h[0]],
@@ -69,7 +70,7 @@ def test_file_layout(runs, key):
             for key_, want in (("Origin", origin), ("Spacing", spacing), ("Direction", np.eye(3).ravel())):
                 assert g.attrs[key_].dtype == np.float64, key_
                 np.testing.assert_allclose(g.attrs[key_], want, rtol=1e-15, atol=0, err_msg=key_)
-            assert sorted(g["PointData"].keys()) == ["a", "b"]
+            assert "CellData" not in g and sorted(g["PointData"].keys()) == ["a", "b"]
             for s in ("a", "b"):
                 ds = g["PointData"][s]
                 assert ds.shape == shape and ds.dtype == np.dtype(r["precision"]), (s, ds.shape, ds.dtype)
@@ -84,7 +85,8 @@ def test_file_layout(runs, key):
     assert doc["file-series-version"] == "1.0"
     assert [e["name"] for e in doc["files"]] == [f"{name}_{s:07d}.vtkhdf" for s in steps]
     np.testing.assert_allclose([e["time"] for e in doc["files"]], [s * r["dt"] for s in steps], rtol=1e-12)
-    # .xmf: XDMF 3 temporal collection of 3DCoRectMesh grids pointing at the snapshots
+    # .xmf: XDMF 3 temporal collection of 3DCoRectMesh grids of the cell corners (origin 0, so
+    # the bounds are the domain) whose cell attributes are the snapshots' PointData datasets
     root = ET.parse(d / f"{name}.xmf").getroot()
     assert root.tag == "Xdmf" and root.get("Version") == "3.0"
     coll = root.find("Domain/Grid")
@@ -92,19 +94,20 @@ def test_file_layout(runs, key):
     grids = coll.findall("Grid")
     assert len(grids) == len(steps)
     dims = " ".join(str(v) for v in shape)
+    mesh = " ".join(str(v + 1 if v > 1 else 1) for v in shape)  # the cell corners
     for g, step in zip(grids, steps):
         assert float(g.find("Time").get("Value")) == pytest.approx(step * r["dt"], rel=1e-12)
         topo = g.find("Topology")
-        assert topo.get("TopologyType") == "3DCoRectMesh" and topo.get("Dimensions") == dims
+        assert topo.get("TopologyType") == "3DCoRectMesh" and topo.get("Dimensions") == mesh
         geo = g.find("Geometry")
         assert geo.get("GeometryType") == "ORIGIN_DXDYDZ"
         o, h = ([float(v) for v in item.text.split()] for item in geo.findall("DataItem"))
-        np.testing.assert_allclose(o, origin[::-1], rtol=1e-15)
+        assert o == [0.0, 0.0, 0.0]  # exactly: the domain's corner
         np.testing.assert_allclose(h, spacing[::-1], rtol=1e-15)
         attrs = g.findall("Attribute")
         assert [a.get("Name") for a in attrs] == ["a", "b"]
         for a in attrs:
-            assert a.get("Center") == "Node" and a.get("AttributeType") == "Scalar"
+            assert a.get("Center") == "Cell" and a.get("AttributeType") == "Scalar"
             item = a.find("DataItem")
             assert item.get("Format") == "HDF" and item.get("Dimensions") == dims
             assert item.get("Precision") == ("8" if r["precision"] == "float64" else "4")
@@ -125,6 +128,9 @@ def test_read_snapshot_and_series(runs, key):
         assert s["step"] == round(time / r["dt"]) and s["dim"] == dim
         np.testing.assert_allclose(s["spacing"], r["h"], rtol=1e-15)
         np.testing.assert_allclose(s["origin"], [x / 2 for x in r["h"]], rtol=1e-15)
+        assert s["layout"] == "PointData"
+        np.testing.assert_allclose(s["bounds"], [(0, n * h) for n, h in zip(r["n"], r["h"])],
+                                   rtol=1e-15, atol=0)
         assert list(s["fields"]) == ["a", "b"]
         for v in s["fields"].values():
             assert v.shape == tuple(reversed(r["n"])) and v.dtype == np.dtype(r["precision"])
@@ -197,8 +203,43 @@ def test_command_line(runs, tmp_path):
     assert res.returncode == 0, res.stderr
     docs = json.loads(res.stdout)
     assert len(docs) == 3 and docs[0]["extent"] == [0, 15, 0, 11, 0, 7]
+    assert docs[0]["shape"] == [16, 12, 8] and docs[0]["layout"] == "PointData"
     assert docs[1]["dtypes"] == {"a": "float32", "b": "float32"}
     bad = tmp_path / "bad.vtkhdf"
     bad.write_text("not hdf5")
     res = subprocess.run([sys.executable, SCRIPT, str(bad)], capture_output=True, text=True)
     assert res.returncode == 1 and res.stderr.count("\n") == 1 and "morphogen_h5: error:" in res.stderr
+
+
+def to_celldata_layout(src, dst):
+    """Copy a snapshot rewritten in the CellData layout (as an intermediate development version
+    wrote): CellData of an image of the cell corners (WholeExtent 0..n, z 0..0 in 2-D,
+    Origin 0)."""
+    shutil.copy(src, dst)
+    with h5py.File(dst, "r+") as f:
+        g = f["VTKHDF"]
+        ext = [int(v) for v in g.attrs["WholeExtent"]]
+        g.move("PointData", "CellData")
+        g.attrs["WholeExtent"] = np.array([ext[2 * a + 1] + 1 if i and ext[2 * a + 1] > 0 else 0
+                                           for a in range(3) for i in (0, 1)], dtype=np.int32)
+        g.attrs["Origin"] = np.zeros(3)
+    return dst
+
+
+@pytest.mark.parametrize("key", ["2d", "3d"])
+def test_celldata_layout_is_read(runs, key, tmp_path):
+    r = runs[key]
+    new = mh.read_snapshot(mh.read_series(str(r["dir"]))[-1][1])
+    cells = mh.read_snapshot(str(to_celldata_layout(new["path"], tmp_path / "cells.vtkhdf")))
+    assert cells["layout"] == "CellData" and new["layout"] == "PointData"
+    for k in ("time", "step", "dim", "shape", "origin", "spacing", "origin3", "spacing3", "bounds",
+              "species", "dtypes"):
+        assert cells[k] == new[k], k
+    for s in new["fields"]:
+        assert np.array_equal(cells["fields"][s], new["fields"][s])
+    assert cells["extent"] == [v + 1 if i % 2 and v else v for i, v in enumerate(new["extent"])]
+    res = subprocess.run([sys.executable, SCRIPT, "--json", str(tmp_path / "cells.vtkhdf")],
+                         capture_output=True, text=True)
+    assert res.returncode == 0, res.stderr
+    doc = json.loads(res.stdout)[0]
+    assert doc["layout"] == "CellData" and doc["shape"] == list(new["shape"])

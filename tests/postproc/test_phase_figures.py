@@ -234,7 +234,9 @@ output_name: "morphogen"
 """
 
 
-def write_vtkhdf(path, fields, spacing=(1.0, 1.0)):
+def write_vtkhdf(path, fields, spacing=(1.0, 1.0), layout="PointData"):
+    """A 2-D snapshot as morphogen writes it (PointData on the cell centres), or with layout
+    "CellData" as an intermediate development version did (the cell corners, Origin 0)."""
     import h5py
 
     ny, nx = next(iter(fields.values())).shape
@@ -242,11 +244,15 @@ def write_vtkhdf(path, fields, spacing=(1.0, 1.0)):
         g = f.create_group("VTKHDF")
         g.attrs["Version"] = np.array([1, 0], dtype=np.int32)
         g.attrs.create("Type", np.bytes_("ImageData"), dtype=h5py.string_dtype("ascii", len("ImageData")))
-        g.attrs["WholeExtent"] = np.array([0, nx - 1, 0, ny - 1, 0, 0], dtype=np.int32)
-        g.attrs["Origin"] = np.array([0.5 * spacing[0], 0.5 * spacing[1], 0.0])
+        if layout == "PointData":
+            g.attrs["WholeExtent"] = np.array([0, nx - 1, 0, ny - 1, 0, 0], dtype=np.int32)
+            g.attrs["Origin"] = np.array([0.5 * spacing[0], 0.5 * spacing[1], 0.0])  # cell centres
+        else:
+            g.attrs["WholeExtent"] = np.array([0, nx, 0, ny, 0, 0], dtype=np.int32)  # cell corners
+            g.attrs["Origin"] = np.zeros(3)
         g.attrs["Spacing"] = np.array([spacing[0], spacing[1], spacing[0]])
         g.attrs["Direction"] = np.eye(3).ravel()
-        pdg = g.create_group("PointData")
+        pdg = g.create_group(layout)
         for name, a in fields.items():
             pdg.create_dataset(name, data=a[None].astype(np.float32))
         f.create_group("morphogen")
@@ -259,6 +265,18 @@ def ingrid_run(d, options=INGRID_OPTIONS):
     a = 4 + np.sin(ii / 3.0) * np.cos(jj / 4.0) * (ii / 63.0)
     write_vtkhdf(d / "morphogen_0001000.vtkhdf", {"a": a, "b": 16 / (a + 1)})
     write_vtkhdf(d / "morphogen_0000000.vtkhdf", {"a": np.full((48, 64), 4.0), "b": np.full((48, 64), 4.0)})
+
+
+def test_read_field_reads_both_layouts(tmp_path):
+    pytest.importorskip("h5py")
+    jj, ii = np.mgrid[0:6, 0:8]
+    a = (ii + 10.0 * jj).astype(np.float32)
+    for layout in ("PointData", "CellData"):
+        path = tmp_path / f"{layout}.vtkhdf"
+        write_vtkhdf(path, {"a": a, "b": -a}, layout=layout)
+        arr, species = pd.read_field(str(path), None)
+        assert species == "a" and np.array_equal(arr, a), layout
+        assert np.array_equal(pd.read_field(str(path), "b")[0], -a), layout
 
 
 def test_detect_axes():

@@ -39,9 +39,11 @@ CYLINDER = ["--surface-x", "cos(2*_pi*u/Lx)", "--surface-y", "sin(2*_pi*u/Lx)",
             "--surface-z", "v/Lx*2*_pi"]
 
 
-def write_snapshot(path, n, L, time=1.5, step=10):
+def write_snapshot(path, n, L, time=1.5, step=10, layout="PointData"):
     """A VTKHDF ImageData snapshot as morphogen writes it: species a (float32, a checkerboard of
-    sines) and b (float64); 2-D when len(n) == 2 (datasets (1, ny, nx)), else 3-D."""
+    sines) and b (float64); 2-D when len(n) == 2 (datasets (1, ny, nx)), else 3-D. layout
+    "PointData": points at the cell centres (WholeExtent 0..n-1, Origin h/2); "CellData": the
+    layout of an intermediate development version (the cell corners, WholeExtent 0..n, Origin 0)."""
     dim = len(n)
     n3 = list(n) + [1] * (3 - dim)
     h = [L[a] / n[a] for a in range(dim)]
@@ -54,12 +56,16 @@ def write_snapshot(path, n, L, time=1.5, step=10):
         g = f.create_group("VTKHDF")
         g.attrs["Version"] = np.array([1, 0], dtype=np.int32)
         g.attrs.create("Type", np.bytes_("ImageData"), dtype=h5py.string_dtype("ascii", 9))
-        extent = [0, n3[0] - 1, 0, n3[1] - 1, 0, n3[2] - 1]
+        if layout == "PointData":
+            extent = [0, n3[0] - 1, 0, n3[1] - 1, 0, n3[2] - 1]
+            g.attrs["Origin"] = np.array(o3)
+        else:  # the cell corners
+            extent = [0, n[0], 0, n[1], 0, n[2] if dim == 3 else 0]
+            g.attrs["Origin"] = np.zeros(3)
         g.attrs["WholeExtent"] = np.array(extent, dtype=np.int32)
-        g.attrs["Origin"] = np.array(o3)
         g.attrs["Spacing"] = np.array(h3)
         g.attrs["Direction"] = np.eye(3).ravel()
-        pd = g.create_group("PointData")
+        pd = g.create_group(layout)
         pd["a"] = a.astype(np.float32)
         pd["b"] = 1.0 + a ** 2
         m = f.create_group("morphogen")
@@ -72,6 +78,8 @@ def write_snapshot(path, n, L, time=1.5, step=10):
 def snaps(tmp_path_factory):
     d = tmp_path_factory.mktemp("surface")
     return {"2d": write_snapshot(d / "syn_0000010.vtkhdf", [64, 32], [64.0, 32.0]),
+            "2d_cells": write_snapshot(d / "cells_0000010.vtkhdf", [64, 32], [64.0, 32.0],
+                                       layout="CellData"),
             "3d": write_snapshot(d / "vol_0000010.vtkhdf", [8, 6, 4], [8.0, 6.0, 4.0])}
 
 
@@ -150,6 +158,19 @@ def test_torus_image_backend(snaps, tmp_path):
     assert proc.returncode == 0, f"{proc.stdout}\n{proc.stderr[-3000:]}"
     assert proc.stdout.strip().splitlines()[-1] == str(out)
     assert_picture(out, (320, 240))
+
+
+def test_both_file_layouts_render_alike(snaps, tmp_path):
+    """A snapshot of the CellData layout (an intermediate development version) maps exactly as
+    the same values in the PointData layout morphogen writes."""
+    pics = []
+    for key in ("2d", "2d_cells"):
+        out = tmp_path / f"{key}.png"
+        proc = render([snaps[key], "--species", "a", *CYLINDER, "--output", out, "--size",
+                       "200x160", "--no-time"])
+        assert proc.returncode == 0, f"{proc.stdout}\n{proc.stderr[-3000:]}"
+        pics.append(assert_picture(out, (200, 160)))
+    assert np.array_equal(pics[0], pics[1])
 
 
 def test_torus_gl_backend(snaps, tmp_path):
