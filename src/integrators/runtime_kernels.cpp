@@ -1,9 +1,11 @@
 #include "integrators/runtime_kernels.hpp"
 
 #include <array>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace morphogen {
 
@@ -12,11 +14,26 @@ namespace {
 // The kernels' model object: rates and jacobian forwarded to the model's callables.
 struct RuntimeKinetics {
   RatesFn rates_fn, jacobian_fn;
+  RatesRowFn rates_row; // may be empty
   void rates(const double* u, const double* p, double* r) const { rates_fn(u, p, r); }
   void jacobian(const double* u, const double* p, double* J) const { jacobian_fn(u, p, J); }
 };
 
-template <int NS, bool FieldParams> auto pre_row(RuntimeKinetics k, int np) {
+// The explicit row: with the model's row rates when it has them (one call per row into a
+// scratch of NS rows, then the update), else cell by cell through rates().
+template <int NS, bool FieldParams>
+std::function<void(const ExplicitRow&)> pre_row(RuntimeKinetics k, int np) {
+  if (k.rates_row)
+    return [row = k.rates_row,
+            scratch = std::make_shared<std::vector<double>>()](const ExplicitRow& a) {
+      const size_t n = static_cast<size_t>(a.n > 0 ? a.n : 0);
+      if (scratch->size() < NS * n) scratch->resize(NS * n);
+      double* r[NS];
+      for (int s = 0; s < NS; ++s)
+        r[s] = scratch->data() + static_cast<size_t>(s) * n;
+      row(a.n, a.src, FieldParams ? a.prow : nullptr, a.pconst, r);
+      explicit_row_pre_rates<NS>(a, r);
+    };
   return [k = std::move(k), np](const ExplicitRow& a) {
     explicit_row_pre_of<NS, kMaxRuntimeParams, FieldParams>(k, np, a);
   };
@@ -60,7 +77,7 @@ ModelKernels runtime_model_kernels(const ModelInfo& model) {
     throw std::invalid_argument(std::string("model ") + model.name + " has " +
                                 std::to_string(model.nparams) + " parameters; allowed at most " +
                                 std::to_string(kMaxRuntimeParams));
-  const RuntimeKinetics k{model.rates, model.jacobian};
+  const RuntimeKinetics k{model.rates, model.jacobian, model.rates_row};
   return dispatch(model.nspecies, k, model.nparams, std::make_index_sequence<kMaxRuntimeSpecies>{});
 }
 

@@ -1,7 +1,9 @@
 // Kernels of a model built at run time (coupled layers, user-defined kinetics): the explicit
 // general path's row update and the split integrator's per-cell reaction row, instantiated for
 // 1..16 species and up to kMaxRuntimeParams parameters, calling the model's kinetics through
-// its callables (ModelInfo::rates, ModelInfo::jacobian). Such a model has no fused sweep.
+// its callables (ModelInfo::rates, ModelInfo::jacobian; the explicit row uses
+// ModelInfo::rates_row, one call per row, when the model has it). Such a model has no fused
+// sweep.
 #pragma once
 
 #include "integrators/model_kernels.hpp"

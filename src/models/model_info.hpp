@@ -20,6 +20,11 @@ namespace morphogen {
 // (models/runtime_model.hpp: coupled layers, user-defined rates) whose state `storage` owns.
 using RatesFn = std::function<void(const double* u, const double* p, double* r)>;
 using SteadyFn = std::function<bool(const double* p, double* u)>;
+// The rates of a row of n cells at once: r[s][i] = R_s(u[0][i], u[1][i], ...; p_i) with
+// p_i[q] = prow[q][i] when prow is non-null (per-cell parameters), else pconst[q]. Bitwise
+// equal to rates() called cell by cell.
+using RatesRowFn = std::function<void(int n, const double* const* u, const double* const* prow,
+                                      const double* pconst, double* const* r)>;
 
 struct ModelInfo {
   const char* name;
@@ -34,12 +39,26 @@ struct ModelInfo {
   RatesFn jacobian; // J[s*N+q] = dR_s/du_q
   SteadyFn steady_state;
   std::shared_ptr<const void> storage; // names and kinetics of a model built at run time
+  // Optional (empty for the compiled models): rates() over a row in one call, for models whose
+  // per-cell call is costly (custom_model: muParser's bulk mode). The explicit general path
+  // uses it when set (integrators/runtime_kernels.cpp).
+  RatesRowFn rates_row = {};
 };
 
 template <class M> ModelInfo model_info() {
-  return {M::name,           M::doc,           M::reference,     M::nspecies, M::nparams,
-          M::species.data(), M::params.data(), M::clamp_default, &M::rates,   &M::jacobian,
-          &M::steady_state,  nullptr};
+  return {M::name,
+          M::doc,
+          M::reference,
+          M::nspecies,
+          M::nparams,
+          M::species.data(),
+          M::params.data(),
+          M::clamp_default,
+          &M::rates,
+          &M::jacobian,
+          &M::steady_state,
+          nullptr,
+          {}};
 }
 
 namespace detail {

@@ -6,10 +6,16 @@
 //     species/parameter names a1, b1, a2, ..., alpha1, ..., couple_a; steady state;
 //   - the runtime kernels' explicit row and backward-Euler reaction row equal the compiled
 //     model's kernels (bitwise for the layer-free model, tolerance 1e-13 otherwise);
-//   - bad names and expressions are one-line UserErrors naming the option.
+//   - bad names and expressions are one-line UserErrors naming the option;
+//   - the custom model's row rates (ModelInfo::rates_row: muParser's bytecode evaluated per row)
+//     equal its per-cell rates bitwise, for rows of several lengths, scalar and per-cell
+//     parameters, every kind of token, and the cell-by-cell fallback (if-then-else); the
+//     explicit row with them equals the per-cell explicit row bitwise.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -88,6 +94,108 @@ TEST(CustomModel, CoordinatesAndTimeAreParametersWithExpressionDefaults) {
   EXPECT_DOUBLE_EQ(r, -0.5 * 3 * 2 + 0.25);
 }
 
+// Bitwise equality of doubles (NaN == NaN of the same payload).
+bool same_bits(double x, double y) {
+  return std::bit_cast<std::uint64_t>(x) == std::bit_cast<std::uint64_t>(y);
+}
+
+TEST(CustomModel, RowRatesEqualPerCellRatesBitwise) {
+  const std::vector<CustomKinetics> specs = {
+      {{"a", "b"},
+       {"s*(alpha - (1 + beta)*a + a^2*b)", "s*(beta*a - a^2*b)"},
+       {"-rate_a", "-rate_b"}},
+      // Gray-Scott; powers 3 and 4, x*c + d, fractional powers, functions of 1, 2 and n
+      // arguments, unary minus, comparisons and logic, division, pi, x*c + d with d != 0
+      // (cmVARMUL: an FMA would change its rounding).
+      {{"a", "b", "c"},
+       {"s*(a^2*b - (F + k)*a) + 3*c - 0.5 + b^3 - c^4/7",
+        "-a^1.5*exp(-b) + sin(pi*c)/(1 + b^2) + atan2(a, b) + max(a, b, c, 0.3) + sum(a, b)",
+        "(a > b) + (b <= c)*2 + (a > 0.1 && c < 2) + sqrt(abs(a - c)) - 2 + "
+        "(0.7*c + 0.3)*(1.1*a - 0.2)"},
+       {"-rate_a", "-rate_b", "-rate_c"}},
+      // if-then-else: rows go cell by cell (still the same results).
+      {{"a", "b"}, {"a > b ? a*k : b - k", "k"}, {"-rate_a", "-rate_b"}},
+  };
+  for (const auto& spec : specs) {
+    const ModelInfo m = custom_model(spec);
+    ASSERT_TRUE(static_cast<bool>(m.rates_row));
+    const int ns = m.nspecies, np = m.nparams;
+    // Lengths growing past the scratch's first size, then shorter again.
+    for (const int n : {1, 3, 7, 64, 65, 200, 5, 130}) {
+      std::vector<std::vector<double>> u(static_cast<size_t>(ns)), p(static_cast<size_t>(np)),
+          r(static_cast<size_t>(ns));
+      std::vector<double> pconst(static_cast<size_t>(np));
+      std::vector<const double*> up, pp;
+      std::vector<double*> rp;
+      for (int s = 0; s < ns; ++s) {
+        for (int i = 0; i < n; ++i)
+          u[s].push_back(0.3 + 0.9 * std::sin(1.3 * i + 2.1 * s) + 0.01 * n);
+        r[s].assign(static_cast<size_t>(n), -7.0);
+        up.push_back(u[s].data()), rp.push_back(r[s].data());
+      }
+      for (int q = 0; q < np; ++q) {
+        pconst[q] = 0.05 + 0.7 * q;
+        for (int i = 0; i < n; ++i)
+          p[q].push_back(pconst[q] * (1 + 0.1 * std::cos(0.7 * i + q)));
+        pp.push_back(p[q].data());
+      }
+      for (const bool field : {false, true}) {
+        m.rates_row(n, up.data(), field ? pp.data() : nullptr, pconst.data(), rp.data());
+        for (int i = 0; i < n; ++i) {
+          std::vector<double> uc(static_cast<size_t>(ns)), pc(static_cast<size_t>(np)),
+              rc(static_cast<size_t>(ns));
+          for (int s = 0; s < ns; ++s)
+            uc[s] = u[s][i];
+          for (int q = 0; q < np; ++q)
+            pc[q] = field ? p[q][i] : pconst[q];
+          m.rates(uc.data(), pc.data(), rc.data());
+          for (int s = 0; s < ns; ++s)
+            EXPECT_TRUE(same_bits(r[s][i], rc[s]))
+                << spec.rates[s] << " n=" << n << " i=" << i << " field=" << field << ": "
+                << r[s][i] << " vs " << rc[s];
+        }
+      }
+    }
+  }
+}
+
+// The explicit row through rates_row equals the per-cell explicit row bitwise.
+TEST(RuntimeKernels, RowRatesExplicitRowEqualsPerCell) {
+  const ModelInfo m = custom_model(
+      {{"a", "b"}, {"s*(a^2*b - (F + k)*a)", "s*(-a^2*b + F*(1 - b))"}, {"-rate_a", "-rate_b"}});
+  ModelInfo per_cell = m;
+  per_cell.rates_row = nullptr;
+  const ModelKernels bulk = runtime_model_kernels(m), cell = runtime_model_kernels(per_cell);
+  for (const int n : {1, 9, 128, 33}) {
+    std::vector<double> a(n), b(n), da(n), db(n), F(n), k(n), s(n, 1.0);
+    for (int i = 0; i < n; ++i) {
+      a[i] = 0.25 + 0.2 * std::sin(0.9 * i), b[i] = 0.5 + 0.3 * std::cos(1.7 * i);
+      da[i] = 1e-3 * std::sin(2.3 * i), db[i] = -2e-3 * std::cos(0.4 * i);
+      F[i] = 0.04 + 0.001 * i, k[i] = 0.06 - 0.0002 * i;
+    }
+    const double pc[3] = {0.04, 0.06, 1.0}, floor[2] = {0.0, -1e300};
+    const double* prow[3] = {F.data(), k.data(), s.data()};
+    const double* src[2] = {a.data(), b.data()};
+    const double* div[2] = {da.data(), db.data()};
+    for (const int field : {0, 1}) {
+      std::vector<double> oa(n), ob(n), ea(n), eb(n);
+      double* dst[2] = {oa.data(), ob.data()};
+      double* edst[2] = {ea.data(), eb.data()};
+      ExplicitRow row;
+      row.n = n, row.src = src, row.div = div, row.floor = floor, row.dt = 0.7;
+      row.pconst = pc, row.prow = field ? prow : nullptr;
+      row.dst = dst;
+      bulk.explicit_pre[field](row);
+      row.dst = edst;
+      cell.explicit_pre[field](row);
+      for (int i = 0; i < n; ++i) {
+        EXPECT_TRUE(same_bits(oa[i], ea[i])) << "n=" << n << " i=" << i << " field=" << field;
+        EXPECT_TRUE(same_bits(ob[i], eb[i])) << "n=" << n << " i=" << i << " field=" << field;
+      }
+    }
+  }
+}
+
 TEST(LayeredModel, NamesRatesJacobianAndSteadyState) {
   const ModelInfo m = layered_model(brusselator(), 3);
   ASSERT_EQ(m.nspecies, 6);
@@ -117,8 +225,12 @@ TEST(LayeredModel, NamesRatesJacobianAndSteadyState) {
       EXPECT_DOUBLE_EQ(r[2 * l + s], expect) << "layer " << l << " species " << s;
       EXPECT_DOUBLE_EQ(J[(2 * l + s) * 6 + 2 * l + s], diag);
       EXPECT_DOUBLE_EQ(J[(2 * l + s) * 6 + 2 * l + 1 - s], Jl[s * 2 + 1 - s]);
-      if (l > 0) EXPECT_DOUBLE_EQ(J[(2 * l + s) * 6 + 2 * (l - 1) + s], k[s]);
-      if (l == 2) EXPECT_DOUBLE_EQ(J[(2 * l + s) * 6 + s], 0.0); // only neighbouring layers
+      if (l > 0) {
+        EXPECT_DOUBLE_EQ(J[(2 * l + s) * 6 + 2 * (l - 1) + s], k[s]);
+      }
+      if (l == 2) { // only neighbouring layers
+        EXPECT_DOUBLE_EQ(J[(2 * l + s) * 6 + s], 0.0);
+      }
     }
   }
   // Equal layers: the common steady state; different layers with coupling: none claimed.
