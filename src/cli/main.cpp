@@ -2,6 +2,7 @@
 //
 //   morphogen [DECK.yaml] [-option value ...]           (one run, app/run_main.hpp)
 //   morphogen sweep DECK.yaml [-option value ...]     (phase-diagram sweep, sweep/sweep_main.hpp)
+//   morphogen screen [DECK.yaml] [-option value ...]  (Turing screen, sweep/screen_main.hpp)
 //   morphogen -help | -help petsc | --version         (app/command_line.hpp)
 //
 // The entry point: the top layer, above app and sweep (which sits on app), so neither of them
@@ -17,6 +18,7 @@
 #include "core/petsc_handle.hpp"
 #include "core/stop_signal.hpp"
 #include "core/user_error.hpp"
+#include "sweep/screen_main.hpp"
 #include "sweep/sweep_main.hpp"
 
 #include <cstdio>
@@ -39,9 +41,10 @@ int main(int argc, char** argv) {
       print_version(PETSC_COMM_WORLD);
     } else {
       if (cl.help != CommandLine::Help::None) Options::request_help();
-      rc = argc > 1 && std::string(argv[1]) == "sweep"
-               ? sweep::run_sweep(&argc, &argv, cl.options_files)
-               : run_main(&argc, &argv, wall_start, cl.options_files);
+      const std::string cmd = argc > 1 ? argv[1] : "";
+      rc = cmd == "sweep"    ? sweep::run_sweep(&argc, &argv, cl.options_files)
+           : cmd == "screen" ? sweep::run_screen(&argc, &argv, cl.options_files)
+                             : run_main(&argc, &argv, wall_start, cl.options_files);
     }
   } catch (const UserError& e) {
     PetscFPrintf(PETSC_COMM_WORLD, PETSC_STDERR, "morphogen: error: %s\n", e.what());
