@@ -18,6 +18,7 @@ import json
 import os
 import signal
 import subprocess
+import sys
 import time
 
 import h5py
@@ -25,6 +26,9 @@ import numpy as np
 import pytest
 
 from conftest import EXE, MPIEXEC, run
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from vtkhdf_layouts import to_celldata_layout  # noqa: E402
 
 BASE = ["-grid_n", "48,40", "-png_every", "0", "-progress_every", "100000"]
 SCHEMES = {"explicit": [], "split": ["-integrator", "split", "-dt", "2"]}
@@ -35,18 +39,6 @@ def fields(path):
         g = f["VTKHDF/PointData"] if "VTKHDF/PointData" in f else f["VTKHDF/CellData"]
         return {k: g[k][...] for k in g}
 
-
-def to_celldata_layout(path):
-    """Rewrite a file in the CellData layout (as an intermediate development version wrote):
-    the cells as CellData of an image of the cell corners (WholeExtent 0..n, z 0..0 in 2-D,
-    Origin 0)."""
-    with h5py.File(path, "r+") as f:
-        g = f["VTKHDF"]
-        ext = [int(v) for v in g.attrs["WholeExtent"]]
-        g.move("PointData", "CellData")
-        g.attrs["WholeExtent"] = np.array([ext[2 * a + 1] + 1 if i and ext[2 * a + 1] > 0 else 0
-                                           for a in range(3) for i in (0, 1)], dtype=np.int32)
-        g.attrs["Origin"] = np.zeros(3)
 
 
 def attrs(path):

@@ -13,6 +13,8 @@ import pytest
 from conftest import SOURCE, launch_runs, option_value  # tests/postproc/conftest.py
 
 sys.path.insert(0, os.path.join(SOURCE, "postproc"))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from vtkhdf_layouts import to_celldata_layout  # noqa: E402
 import morphogen_h5 as mh  # noqa: E402
 
 h5py = pytest.importorskip("h5py")
@@ -211,26 +213,17 @@ def test_command_line(runs, tmp_path):
     assert res.returncode == 1 and res.stderr.count("\n") == 1 and "morphogen_h5: error:" in res.stderr
 
 
-def to_celldata_layout(src, dst):
-    """Copy a snapshot rewritten in the CellData layout (as an intermediate development version
-    wrote): CellData of an image of the cell corners (WholeExtent 0..n, z 0..0 in 2-D,
-    Origin 0)."""
+def to_celldata_layout_copy(src, dst):
+    """A copy of snapshot src at dst, rewritten in the CellData layout."""
     shutil.copy(src, dst)
-    with h5py.File(dst, "r+") as f:
-        g = f["VTKHDF"]
-        ext = [int(v) for v in g.attrs["WholeExtent"]]
-        g.move("PointData", "CellData")
-        g.attrs["WholeExtent"] = np.array([ext[2 * a + 1] + 1 if i and ext[2 * a + 1] > 0 else 0
-                                           for a in range(3) for i in (0, 1)], dtype=np.int32)
-        g.attrs["Origin"] = np.zeros(3)
-    return dst
+    return to_celldata_layout(dst)
 
 
 @pytest.mark.parametrize("key", ["2d", "3d"])
 def test_celldata_layout_is_read(runs, key, tmp_path):
     r = runs[key]
     new = mh.read_snapshot(mh.read_series(str(r["dir"]))[-1][1])
-    cells = mh.read_snapshot(str(to_celldata_layout(new["path"], tmp_path / "cells.vtkhdf")))
+    cells = mh.read_snapshot(str(to_celldata_layout_copy(new["path"], tmp_path / "cells.vtkhdf")))
     assert cells["layout"] == "CellData" and new["layout"] == "PointData"
     for k in ("time", "step", "dim", "shape", "origin", "spacing", "origin3", "spacing3", "bounds",
               "species", "dtypes"):

@@ -32,6 +32,8 @@ import pytest
 from conftest import SOURCE, launch_runs  # tests/postproc/conftest.py
 
 sys.path.insert(0, os.path.join(SOURCE, "postproc"))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from vtkhdf_layouts import to_celldata_layout  # noqa: E402
 import morphogen_h5 as mh  # noqa: E402  (h5py, in this process only)
 
 PVBATCH = shutil.which("pvbatch")
@@ -308,19 +310,6 @@ def test_converter_writes_vti_and_pvd(runs, tmp_path):
             check_image(frame, r, snap, f"{key} .pvd frame {i}", r["vtk_type"])
         check_image(vti_res["frames"][0], r, snaps[-1], f"{key} last .vti", r["vtk_type"])
 
-
-def to_celldata_layout(path):
-    """Rewrite a snapshot in the CellData layout (as an intermediate development version wrote):
-    CellData of an image of the cell corners (WholeExtent 0..n, z 0..0 in 2-D, Origin 0)."""
-    import h5py
-
-    with h5py.File(path, "r+") as f:
-        g = f["VTKHDF"]
-        ext = [int(v) for v in g.attrs["WholeExtent"]]
-        g.move("PointData", "CellData")
-        g.attrs["WholeExtent"] = np.array([ext[2 * a + 1] + 1 if i and ext[2 * a + 1] > 0 else 0
-                                           for a in range(3) for i in (0, 1)], dtype=np.int32)
-        g.attrs["Origin"] = np.zeros(3)
 
 
 @pytest.mark.parametrize("key", ["2d", "3d"])
