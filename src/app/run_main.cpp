@@ -48,6 +48,9 @@ int run_main(int* argc, char*** argv, double wall_start,
   Options opt(comm);
   if (opt.is_set("sweep_axes"))
     throw UserError("-sweep_axes: this deck is a sweep; run it with morphogen sweep DECK.yaml");
+  if (opt.is_set("screen_params"))
+    throw UserError("-screen_params: this is a Turing screen; run it with morphogen screen "
+                    "DECK.yaml (or morphogen screen -screen_params ...)");
   // Coarse-to-fine grid sequencing (Witkin-Kass 5.2, Lawlor): levels 1..L-1 run on grids
   // coarsened by 2^(L-1-l) for -sequence_steps steps each, the last on -grid_n for -steps.
   const int levels = static_cast<int>(

@@ -179,3 +179,10 @@ def test_bad_input_is_one_line_and_writes_nothing(tmp_path, extra, message):
 def test_missing_params_is_refused(tmp_path):
     r = run(["screen", "-model", "brusselator"], tmp_path)
     assert r.returncode == 1 and "-screen_params: missing" in r.stderr
+
+
+def test_screen_options_in_a_plain_run_say_how_to_screen(tmp_path):
+    r = run(BRUSSELATOR + ["-output_dir", "plain"], tmp_path)
+    assert r.returncode == 1
+    assert "-screen_params: this is a Turing screen; run it with morphogen screen" in r.stderr
+    assert not (tmp_path / "plain").exists()
