@@ -164,7 +164,8 @@ std::string load_deck(int* argc, char*** argv, const std::vector<OptionsFileArg>
   refuse_late_deck(*argc, *argv);
   if (!deck.empty()) {
     insert_yaml("deck ", deck);
-    base_dir = std::filesystem::path(deck).parent_path().string();
+    // Absolute, so that options_used.yaml (which records it as -deck_dir) reruns from anywhere.
+    base_dir = std::filesystem::absolute(deck).parent_path().string();
   } else {
     // The default deck of the chosen model (turing: Sanderson Fig. 1), unless an options file
     // is given (app/model_decks.hpp).
@@ -175,6 +176,12 @@ std::string load_deck(int* argc, char*** argv, const std::vector<OptionsFileArg>
   // The command line overrides the deck and the options files.
   MG_PETSC(PetscOptionsInsert(nullptr, argc, argv, nullptr));
   return base_dir;
+}
+
+std::string read_deck_dir(Options& opt, const std::string& deck_dir) {
+  return opt.string("deck_dir", deck_dir,
+                    "directory where relative file names in values (png(...), strokes(...)) are "
+                    "looked up first, then the working directory (default: the deck's)");
 }
 
 } // namespace morphogen

@@ -9,6 +9,8 @@
 // "file:line:column: what" before anything is inserted. Values of any length are kept whole.
 #pragma once
 
+#include "core/options.hpp"
+
 #include <string>
 #include <vector>
 
@@ -35,5 +37,10 @@ struct OptionsFileArg {
 // Loads the deck (or the default), then `files`, then argv. Returns the directory of the deck
 // (for relative file names inside it), or "". UserError on any problem with the deck or a file.
 std::string load_deck(int* argc, char*** argv, const std::vector<OptionsFileArg>& files = {});
+
+// -deck_dir: where relative file names in values (png(...), strokes(...)) are looked up first;
+// its default is the deck's directory from load_deck, so options_used.yaml records it and a
+// rerun from the output directory finds the same files.
+std::string read_deck_dir(Options& opt, const std::string& deck_dir);
 
 } // namespace morphogen

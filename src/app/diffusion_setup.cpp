@@ -1,5 +1,7 @@
 #include "app/diffusion_setup.hpp"
 
+#include "app/state_diffusion_setup.hpp"
+
 #include "core/collective_error.hpp"
 #include "core/user_error.hpp"
 #include "fields/field_fill.hpp"
@@ -122,11 +124,8 @@ std::unique_ptr<SurfaceMap> read_surface(Options& opt, const GridSpec& spec) {
 } // namespace
 
 bool read_tensor_choice(Options& opt, const std::string& name) {
-  const std::string all = opt.choice("diffusion", "iso", {"iso", "tensor"},
-                                     "diffusion of every species: iso (D_S, a number or a field) "
-                                     "or tensor (D_S times the -tensor_* tensor)");
-  return opt.choice("diffusion_" + name, all, {"iso", "tensor"},
-                    "diffusion of species " + name + " (overrides -diffusion)") == "tensor";
+  const std::string kind = read_diffusion_kind(opt, name);
+  return kind == "tensor" || kind == "shaped";
 }
 
 DiffusionSetup read_diffusion(Options& opt, const Grid& grid, const Halo& halo,
@@ -150,6 +149,8 @@ DiffusionSetup read_diffusion(Options& opt, const Grid& grid, const Halo& halo,
   ValueSpec D(dkey, dtext, spec, seed, base_dir);
   if (D.uses_time())
     throw UserError("-" + dkey + " " + D.text() + ": time-dependent diffusion is not supported");
+  if (const std::string kind = read_diffusion_kind(opt, name); kind == "polar" || kind == "shaped")
+    return read_state_diffusion(opt, grid, halo, name, kind, D, seed, base_dir);
   DiffusionSetup out;
   if (D.is_constant() && !tensor) {
     const double v = D.constant_value();

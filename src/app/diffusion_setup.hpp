@@ -1,6 +1,7 @@
 // Per-species diffusion from the options database:
 //
-//   -diffusion iso|tensor, -diffusion_S iso|tensor   (all species / species S; default iso)
+//   -diffusion iso|tensor|polar|shaped, -diffusion_S ...  (all species / species S; default iso;
+//                       polar and shaped: app/state_diffusion_setup.hpp)
 //   -D_S VALUE          D_s: a number, or any value (expression, 'v +- a%', png(...)) for a
 //                       diffusion map; the tensor is multiplied by it
 //   -tensor_scheme second_order|first_order
@@ -19,6 +20,7 @@
 #include "grid/halo.hpp"
 #include "models/model.hpp"
 #include "operators/diffusion_operator.hpp"
+#include "operators/state_diffusion.hpp"
 
 #include <cstdint>
 #include <memory>
@@ -26,11 +28,15 @@
 
 namespace morphogen {
 
-// -diffusion_S resolved for species `name` (reads the option: call once per species).
+// -diffusion_S resolved for species `name`: true when its operator reads the ghost corners
+// (tensor, shaped; polar and shaped: app/state_diffusion_setup.hpp).
 bool read_tensor_choice(Options& opt, const std::string& name);
 
 struct DiffusionSetup {
   std::unique_ptr<DiffusionOperator> op;
+  // Solution-dependent coefficients (-diffusion_S polar|shaped: app/state_diffusion_setup.hpp),
+  // else null.
+  std::unique_ptr<CoefficientRule> rule;
   double D_mean = 0; // spatial mean of D_s (times the mean tensor's trace / dim)
 };
 

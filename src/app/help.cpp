@@ -17,11 +17,12 @@ bool starts_with(const std::string& s, const std::string& p) {
 const std::vector<std::pair<const char*, std::vector<const char*>>>& topics() {
   static const std::vector<std::pair<const char*, std::vector<const char*>>> groups = {
       {"Model and values",
-       {"model", "layers", "species", "rate_", "params_", "D_", "init_", "dirichlet_", "source_",
-        "pin_", "clamp", "seed"}},
+       {"model", "layers", "species", "rate_", "jac_", "params_", "D_", "init_", "dirichlet_",
+        "source_", "pin_", "clamp", "seed"}},
       {"Grid", {"grid_", "stencil", "sequence_"}},
-      {"Diffusion", {"diffusion", "tensor_", "surface_"}},
+      {"Diffusion", {"diffusion", "tensor_", "surface_", "polar_", "shaped_"}},
       {"Time integration", {"integrator", "dt", "force_dt", "steps", "split_", "ts_"}},
+      {"Advection", {"advect", "velocity_"}},
       {"Checkpoints and restart", {"checkpoint_", "restart", "max_walltime"}},
       {"Output",
        {"output_", "png_", "snapshot_", "summary", "progress_every", "nan_check_every", "movie_"}},
@@ -57,8 +58,19 @@ const Conditional kConditional[] = {
      "species' initial value; with -grid_bc dirichlet)"},
     {"png_range_", "-png_range_<species> LO,HI",
      "fixed colour range of the species' images (default: from the data)"},
-    {"diffusion_", "-diffusion_<species> iso|tensor",
+    {"diffusion_", "-diffusion_<species> iso|tensor|polar|shaped",
      "diffusion of one species (default: -diffusion)"},
+    {"polar_", "-polar_form cosine|witkin_kass, -polar_lobes J, -polar_speeds A1,..,AJ",
+     "with -diffusion polar: D_S a(theta), theta the angle of grad u; j cosine lobes with a "
+     "speed each (stable-ARD eq. 16; default 4 lobes, speeds 1) or Witkin-Kass's four lobes "
+     "(eq. 15, speeds a1,a2); also -polar_<species>_<name>"},
+    {"polar_", "-polar_theta0 VALUE",
+     "with -diffusion polar: rotation of a(theta + theta0) in radians, a number or any value "
+     "(field) (default 0)"},
+    {"shaped_", "-shaped_I I, -shaped_vx VALUE, -shaped_vy VALUE, -shaped_vz VALUE",
+     "with -diffusion shaped: the -tensor_theta/l1/l2 tensor with l1 + dl, l2 - dl, dl = I "
+     "(grad u/|grad u|).(v/|v|) (Sanderson eqs. 18-19; default I 0.25, v the first principal "
+     "direction); also -shaped_<species>_<name>"},
     {"tensor_", "-tensor_<name>, -tensor_<species>_<name>",
      "diffusion tensor (theta, l1, l2[, phi, l3] or xx, xy, yy[, xz, yz, zz]; with -diffusion "
      "tensor)"},
@@ -71,6 +83,17 @@ const Conditional kConditional[] = {
     {"split_", "-split_newton_tol X, -split_newton_max_it N",
      "per-cell Newton tolerance (default 1e-12, allowed [1e-16, 0.01]) and iteration cap "
      "(default 20, allowed [1, 1000])"},
+    {"advect", "-advect a,b",
+     "species carried by the velocity: semi-Lagrangian advection after reaction and diffusion "
+     "each step, with every integrator (default: none)"},
+    {"advect", "-velocity_x EXPR, -velocity_y EXPR, -velocity_z EXPR",
+     "with -advect: velocity components, expressions of x, y, z, t (default 0; once per step "
+     "at t + dt/2 if t is used)"},
+    {"advect", "-advection_scheme linear|cubic, -advection_backtrace rk2|euler",
+     "with -advect: interpolation at the departure point (default linear) and its back-trace "
+     "(default rk2; euler is the stable-ARD paper's eq. 20)"},
+    {"advect", "-advection_halo W",
+     "with -advect: halo width in cells (default 0: from max|u| dt/h at the start; at most 64)"},
     {"sequence_steps", "-sequence_steps N1,...",
      "steps on each coarse level, coarsest first (with -sequence_levels L > 1: L-1 values)"},
     {"", "-diffusion_ksp_*, -diffusion_pc_*",
@@ -129,7 +152,8 @@ void print_models_help(MPI_Comm comm) {
   PetscPrintf(comm, "  %-18s %s\n", "custom",
               "user-defined kinetics: -species a,b and -rate_a EXPR, -rate_b EXPR (muParser, "
               "functions of the species); every other name in a rate is a parameter, given "
-              "with -params_NAME");
+              "with -params_NAME; optional Jacobian -jac_a_b EXPR (dR_a/db, all entries or "
+              "none: central differences) for the implicit paths");
   PetscPrintf(comm, "  %-18s %s\n", "-layers L",
               "L coupled copies of any model (Sanderson et al. 2006, eqs. 20-21): species a1, "
               "b1, a2, b2, ...; parameters alpha1, ...; coupling rates -params_couple_a, ... "

@@ -4,11 +4,40 @@
 #include "integrators/runtime_kernels.hpp"
 #include "models/runtime_model.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace morphogen {
 
 namespace {
+
+// -jac_<s>_<q> EXPR: dR_s/du_q, all ns^2 entries or none (then central differences).
+void read_custom_jacobian(Options& opt, CustomKinetics& spec) {
+  std::vector<std::string> missing, keys;
+  for (const auto& s : spec.species)
+    for (const auto& q : spec.species) {
+      const std::string key = "jac_" + s + "_" + q;
+      if (std::count(keys.begin(), keys.end(), key))
+        throw UserError("-" + key +
+                        ": names two Jacobian entries (species names joined by _ "
+                        "are ambiguous): rename the species");
+      keys.push_back(key);
+      const auto text = opt.get(key, "Jacobian entry dR_" + s + "/d" + q +
+                                         " (custom model): an expression like the rates; all "
+                                         "entries or none (finite differences)");
+      if (text) {
+        spec.jac.push_back(*text);
+        spec.jac_keys.push_back("-" + key);
+      } else {
+        missing.push_back("-" + key);
+      }
+    }
+  if (spec.jac.empty()) return;
+  if (!missing.empty())
+    throw UserError(missing.front() + ": missing; a Jacobian by expressions needs all " +
+                    std::to_string(keys.size()) + " entries -jac_<s>_<q> (" +
+                    std::to_string(missing.size()) + " missing), or none for finite differences");
+}
 
 // Under -layers L each parameter p of the rates is given per layer (-params_p1, ...).
 ModelInfo read_custom(Options& opt, int layers) {
@@ -29,6 +58,7 @@ ModelInfo read_custom(Options& opt, int layers) {
     spec.rates.push_back(*text);
     spec.keys.push_back("-" + key);
   }
+  read_custom_jacobian(opt, spec);
   ModelInfo m = custom_model(spec);
   std::string species;
   for (const auto& s : spec.species)

@@ -5,6 +5,8 @@
 //   -species LIST   (custom) the species names, e.g. a,b
 //   -rate_S EXPR    (custom) the rate of species S, an expression of the species and of
 //                   parameters, each given with -params_NAME
+//   -jac_S_Q EXPR   (custom, optional) dR_S/dQ for the implicit paths: all entries or none
+//                   (none: central differences)
 #pragma once
 
 #include "app/model_registry.hpp"

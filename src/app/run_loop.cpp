@@ -34,6 +34,7 @@ bool run_loop(Simulation& sim, PetscInt end_step, RunOutput& output, PngOutput& 
     }
   };
   if (sim.level() == 0) warn_if_reaction_stiff(sim);
+  if (sim.advection()) PetscPrintf(comm, "%s\n", sim.advection()->describe().c_str());
   for (PetscInt n = 1; n <= steps; ++n) {
     sim.step();
     if (n % out.nan_check_every == 0 || n == steps) check_finite();

@@ -44,8 +44,9 @@ void print_header(MPI_Comm comm, const Simulation& sim, int level, int levels) {
 int run_main(int* argc, char*** argv, double wall_start,
              const std::vector<OptionsFileArg>& options_files) {
   MPI_Comm comm = PETSC_COMM_WORLD;
-  const std::string base_dir = load_deck(argc, argv, options_files);
+  const std::string deck_dir = load_deck(argc, argv, options_files);
   Options opt(comm);
+  const std::string base_dir = read_deck_dir(opt, deck_dir);
   if (opt.is_set("sweep_axes"))
     throw UserError("-sweep_axes: this deck is a sweep; run it with morphogen sweep DECK.yaml");
   if (opt.is_set("screen_params"))

@@ -1,5 +1,6 @@
 #include "app/simulation.hpp"
 
+#include "app/device_types.hpp"
 #include "app/diffusion_setup.hpp"
 #include "app/model_setup.hpp"
 #include "core/collective_error.hpp"
@@ -7,6 +8,7 @@
 #include "core/user_error.hpp"
 #include "fields/field_fill.hpp"
 #include "grid/prolong.hpp"
+#include "operators/advection_setup.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -26,6 +28,7 @@ Simulation::Simulation(MPI_Comm comm, Options& opt, const std::string& base_dir,
   read_grid(opt, level);
   read_model(opt, base_dir);
   read_time(opt);
+  advection_ = read_advection(opt, *grid_, species_, seed_, base_dir, dt_);
   read_output(opt);
   if (level.coarser) start_from(*level.coarser);
 }
@@ -119,6 +122,7 @@ void Simulation::read_grid(Options& opt, const SequenceLevel& level) {
   spec_.stencil_width = 1;
   spec_.box_stencil = stencil_.nterms == 9;
   read_diffusion_kinds(opt, st);
+  read_device_types(opt);
   grid_ = std::make_unique<Grid>(comm_, spec_);
   spec_ = grid_->spec();
   halo_ = std::make_unique<Halo>(*grid_);
@@ -213,6 +217,7 @@ void Simulation::read_model(Options& opt, const std::string& base_dir) {
   dirichlet_.assign(any_dirichlet ? ns : 0, FaceValues{});
   u_.clear();
   ops_.clear();
+  rules_.clear();
   for (int s = 0; s < ns; ++s) {
     const SpeciesInfo& si = model_->species[s];
     species_.emplace_back(si.name);
@@ -223,6 +228,7 @@ void Simulation::read_model(Options& opt, const std::string& base_dir) {
                       " needs -stencil 5pt (the map's operator has its own 5-point form)");
     D_[s] = ds.D_mean;
     ops_.push_back(std::move(ds.op));
+    rules_.push_back(std::move(ds.rule));
     const std::string ikey = std::string("init_") + si.name;
     ValueSpec init(ikey,
                    opt.string(ikey, format_double(si.init),
@@ -405,7 +411,12 @@ void Simulation::read_time(Options& opt) {
 // The run's terms: diffusion per species, the reaction, sources, and the clamp floor.
 void Simulation::build_terms() {
   for (size_t s = 0; s < ops_.size(); ++s)
-    terms_.add(std::make_unique<DiffusionTerm>(static_cast<int>(s), species_[s], *ops_[s]));
+    if (rules_[s]) // solution-dependent: refreshed per step (operators/state_diffusion.hpp)
+      terms_.add(std::make_unique<StateDiffusionTerm>(static_cast<int>(s), species_[s], *ops_[s],
+                                                      *halo_, std::move(rules_[s])),
+                 true);
+    else
+      terms_.add(std::make_unique<DiffusionTerm>(static_cast<int>(s), species_[s], *ops_[s]));
   terms_.add(std::make_unique<ReactionTerm>(*grid_, model_->name, model_->rates, model_->nspecies,
                                             params_, timed_.get()));
   if (sources_->any()) terms_.add(std::make_unique<SourceTerm>(*grid_, *sources_, species_));
@@ -433,6 +444,7 @@ void Simulation::read_ts(Options& opt) {
     matrices_ = std::make_unique<OperatorMatrices>(*grid_, *halo_, stencil_, operators(),
                                                    dirichlet_.empty() ? nullptr : &dirichlet_);
     pin_matrices();
+    terms_.use_matrices(matrices_.get()); // lagged solution-dependent operators re-assembled
   }
   ts_integrator_ = std::make_unique<TsIntegrator>(*grid_, *halo_, species_, terms_, matrices_.get(),
                                                   dirichlet_.empty() ? nullptr : &dirichlet_, dt_);
@@ -465,6 +477,7 @@ void Simulation::read_split(Options& opt) {
   matrices_ = std::make_unique<OperatorMatrices>(*grid_, *halo_, stencil_, operators(),
                                                  dirichlet_.empty() ? nullptr : &dirichlet_);
   pin_matrices();
+  terms_.use_matrices(matrices_.get()); // lagged solution-dependent operators re-assembled
   diffusion_ = std::make_unique<DiffusionSolver>(*grid_, *matrices_, species_, opt);
   diffusion_->prepare(dt_, set.theta);
   split_integrator_ = std::make_unique<SplitIntegrator>(
@@ -558,6 +571,12 @@ void Simulation::step() {
   // (second order with Strang); the TS right-hand side evaluates them at its stage times.
   if (timed_->any() && !ts_) timed_->set_time(params_, split_ ? t_ + 0.5 * dt_ : t_);
   stepper_->step(u_, t_, dt_, step_ + 1);
+  // Advection after reaction and diffusion (stable-ARD section 5.2), then the constraints again
+  // (pinned cells, the clamp floor under cubic overshoots).
+  if (advection_) {
+    advection_->apply(u_, t_, dt_);
+    terms_.constrain(u_);
+  }
   t_ += dt_;
   ++step_;
 }

@@ -13,7 +13,9 @@
 #include "integrators/explicit_integrator.hpp"
 #include "integrators/split_integrator.hpp"
 #include "integrators/ts_integrator.hpp"
+#include "operators/advection_stage.hpp"
 #include "operators/pointwise_terms.hpp"
+#include "operators/state_diffusion.hpp"
 #include "operators/term_list.hpp"
 
 #include <memory>
@@ -93,6 +95,8 @@ public:
   bool split() const { return split_; }
   const DiffusionSolver* diffusion_solver() const { return diffusion_.get(); }
   const SplitIntegrator* split_integrator() const { return split_integrator_.get(); }
+  // The advection stage run after each step (-advect), or null.
+  const AdvectionStage* advection() const { return advection_.get(); }
   // Make ghosts current (after initialisation or before reading neighbours).
   void refresh_ghosts() { integrator_->update_ghosts(u_); }
   // Collective: throws UserError naming species, cell, step and time if any value is NaN/Inf.
@@ -131,6 +135,7 @@ private:
   std::vector<std::vector<PinnedCells::Cell>> pins_; // per species: this rank's pinned cells
   bool any_pins_ = false;
   std::vector<std::unique_ptr<DiffusionOperator>> ops_;
+  std::vector<std::unique_ptr<CoefficientRule>> rules_; // per species: polar/shaped, else null
   std::unique_ptr<OperatorMatrices> matrices_; // split and TS; before the integrators using it
   std::unique_ptr<SourceTerms> sources_;
   TermList terms_; // after the operators, parameters and sources its terms refer to
@@ -138,7 +143,8 @@ private:
   std::unique_ptr<DiffusionSolver> diffusion_;
   std::unique_ptr<SplitIntegrator> split_integrator_;
   std::unique_ptr<TsIntegrator> ts_integrator_;
-  Integrator* stepper_ = nullptr; // the integrator step() uses
+  Integrator* stepper_ = nullptr;             // the integrator step() uses
+  std::unique_ptr<AdvectionStage> advection_; // after every integrator's step (-advect)
   bool split_ = false, ts_ = false, ts_implicit_diffusion_ = true;
   PetscInt level_factor_ = 1; // coarsening factor of this sequencing level (1: finest)
   int level_index_ = 0;

@@ -5,13 +5,19 @@
 // DMGlobalToLocal copy, and the general explicit path (diffusion tensor, diffusion map) with its
 // own bytes per update and its ratio to the fused path, and Gray-Scott written as a custom model
 // (-model custom: muParser expressions, evaluated a row at a time) against the compiled
-// gray_scott with the same settings. Runs on any number of ranks (aggregate
+// gray_scott with the same settings. First (-bench_implicit, issue 13 part 1): the split
+// integrator's per-cell reaction solve in ns per cell (target <= 10), a split step against an
+// explicit step on the same grid and ranks (target <= 10x) and the Brusselator deck to t = 125
+// explicit vs split (target >= 4x faster, same pattern). Runs on any number of ranks (aggregate
 // figures). Last line:
 //   roofline_fraction=<2-D fraction>
+#include "app/pattern_summary.hpp"
 #include "app/simulation.hpp"
 #include "core/user_error.hpp"
+#include "integrators/reaction_lockstep_kernel.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <tuple>
 #include <vector>
@@ -140,6 +146,194 @@ SplitResult bench_split(MPI_Comm comm, Options& opt,
   return r;
 }
 
+// ---------------------------------------------------------------------------------------------
+// Implicit steps against explicit ones (issue 13 part 1), on the Brusselator deck
+// (input/brusselator.yaml: periodic, h = 1.5, D 49.4 / 117.6, explicit dt 0.0025, split dt 0.1).
+
+using OptionPairs = std::vector<std::pair<std::string, std::string>>;
+
+void set_case(const OptionPairs& opts) {
+  static const char* const keys[] = {"-model",
+                                     "-grid_n",
+                                     "-grid_L",
+                                     "-grid_bc",
+                                     "-init_a",
+                                     "-init_b",
+                                     "-params_alpha",
+                                     "-params_beta",
+                                     "-params_s",
+                                     "-integrator",
+                                     "-dt",
+                                     "-D_a",
+                                     "-D_b",
+                                     "-diffusion",
+                                     "-diffusion_solver",
+                                     "-diffusion_pc_type",
+                                     "-diffusion_pc_mg_levels",
+                                     "-diffusion_pc_mg_galerkin",
+                                     "-diffusion_pc_hypre_type",
+                                     "-params_F",
+                                     "-params_k",
+                                     "-species",
+                                     "-rate_a",
+                                     "-rate_b",
+                                     "-tensor_theta",
+                                     "-tensor_l1",
+                                     "-tensor_l2"};
+  for (const char* k : keys)
+    MG_PETSC(PetscOptionsClearValue(nullptr, k));
+  for (auto& [k, v] : opts)
+    MG_PETSC(PetscOptionsSetValue(nullptr, k.c_str(), v.c_str()));
+}
+
+OptionPairs brusselator_deck(int n, const std::string& integrator, const std::string& dt,
+                             const std::string& solver = "auto") {
+  OptionPairs o = {{"-model", "brusselator"},
+                   {"-grid_n", std::to_string(n) + "," + std::to_string(n)},
+                   {"-grid_L", std::to_string(1.5 * n)},
+                   {"-grid_bc", "periodic"},
+                   {"-params_alpha", "3"},
+                   {"-params_beta", "9"},
+                   {"-params_s", "1"},
+                   {"-D_a", "49.4"},
+                   {"-D_b", "117.6"},
+                   {"-init_a", "3 +- 1%"},
+                   {"-init_b", "3 +- 1%"},
+                   {"-integrator", integrator},
+                   {"-dt", dt}};
+  if (integrator == "split") o.push_back({"-diffusion_solver", solver});
+  return o;
+}
+
+// Seconds per step (best of 3 blocks of `steps`, after 2 warm-up steps).
+double seconds_per_step(MPI_Comm comm, Options& opt, const OptionPairs& o, int steps) {
+  set_case(o);
+  Simulation sim(comm, opt, "");
+  sim.step();
+  sim.step();
+  double best = 1e30;
+  for (int rep = 0; rep < 3; ++rep) {
+    MPI_Barrier(comm);
+    const double t0 = MPI_Wtime();
+    for (int i = 0; i < steps; ++i)
+      sim.step();
+    MPI_Barrier(comm);
+    best = std::min(best, (MPI_Wtime() - t0) / steps);
+  }
+  return best;
+}
+
+// The per-cell reaction substep alone: nanoseconds per cell of the Strang half-step (dt 0.05,
+// trapezoidal, tol 1e-12) for Brusselator cells spread +-30 % around the steady state (a formed
+// pattern's range), the per-cell solver (reaction_row) against the lockstep one.
+void bench_reaction_kernel(MPI_Comm comm) {
+  using M = models::Brusselator;
+  const int n = 256, rows = 256;
+  std::vector<double> a(n * rows), b(n * rows), oa(n), ob(n);
+  for (int i = 0; i < n * rows; ++i) {
+    a[i] = 3.0 * (1.0 + 0.3 * std::sin(0.37 * i));
+    b[i] = 3.0 * (1.0 - 0.3 * std::sin(0.37 * i + 0.5));
+  }
+  const double p[3] = {3, 9, 1}, floor[2] = {-HUGE_VAL, -HUGE_VAL};
+  double* out[2] = {oa.data(), ob.data()};
+  auto time = [&](bool lockstep, int* its) {
+    double best = 1e30;
+    for (int rep = 0; rep < 5; ++rep) {
+      const double t0 = MPI_Wtime();
+      for (int r = 0; r < rows; ++r) {
+        const double* in[2] = {a.data() + r * n, b.data() + r * n};
+        CellSolve w{};
+        const int bad =
+            lockstep
+                ? reaction_row_lockstep<M, false>(ReactionScheme::Trapezoidal, n, in, nullptr, p,
+                                                  nullptr, nullptr, 0.05, 1e-12, 20, floor, out, &w)
+                : reaction_row<M, false>(ReactionScheme::Trapezoidal, n, in, nullptr, p, nullptr,
+                                         nullptr, 0.05, 1e-12, 20, floor, out, &w);
+        if (bad >= 0) throw UserError("bench: reaction kernel failed");
+        *its = std::max(*its, w.iterations);
+      }
+      best = std::min(best, MPI_Wtime() - t0);
+    }
+    return 1e9 * best / (n * rows);
+  };
+  int its_g = 0, its_l = 0;
+  const double g = time(false, &its_g), l = time(true, &its_l);
+  PetscPrintf(comm,
+              "split_reaction_kernel model=brusselator scheme=trapezoidal dt=0.05 cells=%d "
+              "per_cell_ns=%.1f lockstep_ns=%.1f speedup=%.1f newton_its_max=%d "
+              "target_lockstep_ns<=10 %s\n",
+              n * rows, g, l, g / l, its_l, l <= 10.0 ? "met" : "NOT met");
+}
+
+// A split step (auto: FFT where it applies, and KSP) against an explicit step on the same grid
+// and ranks, Brusselator deck settings at n^2.
+void bench_split_vs_explicit(MPI_Comm comm, Options& opt, int n, int steps) {
+  const int ex_steps = std::max(10, steps * 20);
+  const double ex =
+      seconds_per_step(comm, opt, brusselator_deck(n, "explicit", "0.0025"), ex_steps);
+  for (const char* solver : {"auto", "ksp"}) {
+    const double sp =
+        seconds_per_step(comm, opt, brusselator_deck(n, "split", "0.1", solver), steps);
+    PetscPrintf(comm,
+                "split_vs_explicit grid=%dx%d model=brusselator diffusion_solver=%s "
+                "split_step_ms=%.3f explicit_step_ms=%.4f ratio=%.1f target_ratio<=10 %s\n",
+                n, n, solver, 1e3 * sp, 1e3 * ex, sp / ex, sp / ex <= 10.0 ? "met" : "NOT met");
+  }
+}
+
+struct DeckRun {
+  double seconds = 0, wavelength = 0;
+  long spots = 0;
+  std::string cls;
+};
+
+DeckRun run_deck(MPI_Comm comm, Options& opt, const OptionPairs& o, PetscInt steps) {
+  set_case(o);
+  Simulation sim(comm, opt, "");
+  MPI_Barrier(comm);
+  const double t0 = MPI_Wtime();
+  for (PetscInt i = 0; i < steps; ++i)
+    sim.step();
+  MPI_Barrier(comm);
+  DeckRun r;
+  r.seconds = MPI_Wtime() - t0;
+  const nlohmann::json c = classify_species(sim, 0, nullptr);
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  if (rank == 0) {
+    r.cls = c["class"].get<std::string>();
+    const auto& m = c["metrics"];
+    r.spots = std::max(m["high"]["spots"].get<long>(), m["low"]["spots"].get<long>());
+    r.wavelength = m["wavelength"].is_number() ? m["wavelength"].get<double>() : 0.0;
+  }
+  return r;
+}
+
+// input/brusselator.yaml to t = 125: explicit dt 0.0025 against split dt 0.1 (species a).
+void bench_brusselator_deck(MPI_Comm comm, Options& opt, double T) {
+  const PetscInt ex_steps = static_cast<PetscInt>(std::lround(T / 0.0025));
+  const PetscInt sp_steps = static_cast<PetscInt>(std::lround(T / 0.1));
+  const DeckRun ex = run_deck(comm, opt, brusselator_deck(256, "explicit", "0.0025"), ex_steps);
+  const DeckRun sp = run_deck(comm, opt, brusselator_deck(256, "split", "0.1"), sp_steps);
+  const double dspots = ex.spots ? std::fabs(double(sp.spots - ex.spots)) / ex.spots : 1.0;
+  const double dlam = ex.wavelength > 0 ? std::fabs(sp.wavelength / ex.wavelength - 1.0) : 1.0;
+  const double speedup = ex.seconds / sp.seconds;
+  const bool same = sp.cls == ex.cls && dspots <= 0.05 && dlam <= 0.02;
+  PetscPrintf(comm,
+              "brusselator_deck T=%g explicit dt=0.0025 steps=%d seconds=%.2f class=%s spots=%ld "
+              "wavelength=%.2f\n",
+              T, static_cast<int>(ex_steps), ex.seconds, ex.cls.c_str(), ex.spots, ex.wavelength);
+  PetscPrintf(comm,
+              "brusselator_deck T=%g split dt=0.1 steps=%d seconds=%.2f class=%s spots=%ld "
+              "wavelength=%.2f\n",
+              T, static_cast<int>(sp_steps), sp.seconds, sp.cls.c_str(), sp.spots, sp.wavelength);
+  PetscPrintf(comm,
+              "brusselator_deck speedup_split_vs_explicit=%.2f target>=4 %s; same pattern "
+              "(class, spots +-5%%, wavelength +-2%%): %s (spots %.1f%%, wavelength %.1f%%)\n",
+              speedup, speedup >= 4.0 ? "met" : "NOT met", same ? "yes" : "NO", 100 * dspots,
+              100 * dlam);
+}
+
 int run(MPI_Comm comm) {
   int size = 1;
   MPI_Comm_size(comm, &size);
@@ -154,6 +348,14 @@ int run(MPI_Comm comm) {
       opt.integer("bench_steps_split", 5, 1, 100000, "timed split steps per preconditioner");
   const PetscInt mb =
       opt.integer("bench_stream_mb", 256, 8, 65536, "STREAM array size per rank, MiB");
+  const bool with_implicit =
+      opt.flag("bench_implicit", true,
+               "time the implicit path against explicit: reaction kernel, split step at 256^2 and "
+               "1024^2, and the Brusselator deck (issue 13 part 1)");
+  const double deck_T = opt.real("bench_brusselator_T", 125.0, 0.0, 1e6,
+                                 "simulated time of the Brusselator deck comparison (0: skip)");
+  const bool only_implicit =
+      opt.flag("bench_only_implicit", false, "only the implicit-vs-explicit section");
   const double bw = stream_triad(comm, static_cast<size_t>(mb) * 1024 * 1024 / 8, 10);
   const double roof = bw / 32.0;
   PetscPrintf(comm, "ranks=%d\nstream_triad_GBps=%.2f\nroofline_cell_updates_per_s=%.4e\n", size,
@@ -166,6 +368,15 @@ int run(MPI_Comm comm) {
     PetscPrintf(comm, "halo_%s halo_only_update_ms=%.4f dm_global_to_local_ms=%.4f\n", tag,
                 1e3 * r.halo_s, 1e3 * r.g2l_s);
   };
+  if (with_implicit) {
+    bench_reaction_kernel(comm);
+    bench_split_vs_explicit(comm, opt, 256, static_cast<int>(split_steps) * 4);
+    opt.check_unused();
+    bench_split_vs_explicit(comm, opt, 1024, static_cast<int>(split_steps));
+    if (deck_T > 0) bench_brusselator_deck(comm, opt, deck_T);
+  }
+  if (only_implicit) return 0;
+  set_case({});
   const Result r2 = bench_explicit(comm, opt, "1024,1024", static_cast<int>(steps2));
   opt.check_unused();
   report("2d", "1024x1024", r2);

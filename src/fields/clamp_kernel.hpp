@@ -6,9 +6,11 @@
 // the clamp's own outputs never produce: results stay bitwise those of the old form.
 #pragma once
 
+#include "core/host_device.hpp"
+
 namespace morphogen {
 
-inline double clamp_to_floor(double v, double floor) {
+MG_HD inline double clamp_to_floor(double v, double floor) {
   return floor > v ? floor : v;
 }
 

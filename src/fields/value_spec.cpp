@@ -3,6 +3,7 @@
 #include "core/hash_rng.hpp"
 #include "core/options.hpp"
 #include "core/user_error.hpp"
+#include "fields/strokes_field.hpp"
 
 #include <cmath>
 #include <muParser.h>
@@ -30,6 +31,25 @@ size_t find_plus_minus(const std::string& s) {
     if (depth == 0 && c == '+' && s[p + 1] == '-') return p;
   }
   return std::string::npos;
+}
+
+// A file named in a value: relative to the deck's directory when it exists there.
+std::string resolve_path(const std::string& base_dir, const std::string& file) {
+  if (base_dir.empty() || file.empty() || file[0] == '/') return file;
+  const std::string alt = base_dir + "/" + file;
+  if (FILE* f = std::fopen(alt.c_str(), "rb")) {
+    std::fclose(f);
+    return alt;
+  }
+  return file;
+}
+
+// Cell index of coordinate x along axis d: wrapped (periodic) or clamped to the grid.
+int cell_of(double x, const GridSpec& g, int d) {
+  const long n = static_cast<long>(g.n[d]);
+  long c = static_cast<long>(std::floor(x / g.h(d)));
+  if (g.bc[d] == Boundary::Periodic) return static_cast<int>(((c % n) + n) % n);
+  return static_cast<int>(c < 0 ? 0 : (c >= n ? n - 1 : c));
 }
 
 double periodic_delta(double d, double L, bool periodic) {
@@ -136,6 +156,18 @@ struct ValueSpecFunctions {
     const double u = v.x_ / v.grid_.L[0], w = v.y_ / v.grid_.L[1];
     return lo + (hi - lo) * io::sample_bilinear(it->second, u, w);
   }
+  static double stroke_value(void* p, const std::string& key, bool distance) {
+    auto& v = vs(p);
+    const auto it = v.strokes_.find(key);
+    if (it == v.strokes_.end()) return std::nan("");
+    const int i = cell_of(v.x_, v.grid_, 0), j = cell_of(v.y_, v.grid_, 1);
+    return distance ? it->second->distance_at(i, j) : it->second->theta_at(i, j);
+  }
+  static double strokes(void* p, const char* file) { return stroke_value(p, file, false); }
+  static double strokes_directed(void* p, const char* file) {
+    return stroke_value(p, std::string("@") + file, false);
+  }
+  static double strokes_distance(void* p, const char* file) { return stroke_value(p, file, true); }
 };
 
 ValueSpec::ValueSpec(const std::string& key, const std::string& text, const GridSpec& grid,
@@ -166,20 +198,13 @@ ValueSpec::ValueSpec(const std::string& key, const std::string& text, const Grid
   static const std::regex png_re(R"(png\s*\(\s*"([^"]*)\")");
   for (std::sregex_iterator it(expr.begin(), expr.end(), png_re), end; it != end; ++it) {
     const std::string file = (*it)[1].str();
-    std::string path = file;
-    if (!base_dir_.empty() && !file.empty() && file[0] != '/') {
-      const std::string alt = base_dir_ + "/" + file;
-      if (FILE* f = std::fopen(alt.c_str(), "rb")) {
-        std::fclose(f);
-        path = alt;
-      }
-    }
     try {
-      images_.emplace(file, io::read_png_grey(path));
+      images_.emplace(file, io::read_png_grey(resolve_path(base_dir_, file)));
     } catch (const UserError& e) {
       throw UserError("-" + key + " " + text + ": " + e.what());
     }
   }
+  load_strokes(expr);
 
   mu::Parser& P = *parser_;
   try {
@@ -208,10 +233,14 @@ ValueSpec::ValueSpec(const std::string& key, const std::string& text, const Grid
     P.DefineFunUserData("noise", &ValueSpecFunctions::noise, this, false);
     P.DefineFunUserData("gnoise", &ValueSpecFunctions::gnoise, this, false);
     P.DefineFunUserData("png", &ValueSpecFunctions::png, this, false);
+    P.DefineFunUserData("strokes", &ValueSpecFunctions::strokes, this, false);
+    P.DefineFunUserData("strokes_directed", &ValueSpecFunctions::strokes_directed, this, false);
+    P.DefineFunUserData("strokes_distance", &ValueSpecFunctions::strokes_distance, this, false);
     P.SetExpr(expr);
     const auto& used = P.GetUsedVar(); // parses; throws on syntax errors
     uses_t_ = used.count("t") > 0;
-    static const std::regex cellwise(R"(\b(square|disk|ball|spots|noise|gnoise|png)\s*\()");
+    static const std::regex cellwise(
+        R"(\b(square|disk|ball|spots|noise|gnoise|png|strokes\w*)\s*\()");
     const bool cell_funcs = std::regex_search(expr, cellwise);
     uniform_ =
         (used.empty() || (used.size() == 1 && uses_t_)) && !cell_funcs && perturb_ == Perturb::None;
@@ -227,6 +256,31 @@ ValueSpec::ValueSpec(const std::string& key, const std::string& text, const Grid
 }
 
 ValueSpec::~ValueSpec() = default;
+
+// Stroke files named in strokes("..."), strokes_directed("...") and strokes_distance("...") are
+// read and their fields computed (or found in the cache) up front: a bad file fails at setup.
+void ValueSpec::load_strokes(const std::string& expr) {
+  static const std::regex re(R"(\b(strokes|strokes_directed|strokes_distance)\s*\(\s*"([^"]*)\")");
+  for (std::sregex_iterator it(expr.begin(), expr.end(), re), end; it != end; ++it) {
+    const bool directed = (*it)[1].str() == "strokes_directed";
+    const std::string file = (*it)[2].str(), mapkey = (directed ? "@" : "") + file;
+    if (strokes_.count(mapkey)) continue;
+    if (static_cast<long>(grid_.n[0]) * static_cast<long>(grid_.n[1]) > kMaxStrokeCells)
+      throw UserError("-" + key_ + " " + text_ + ": stroke fields are computed whole on every " +
+                      "rank; grid " + std::to_string(grid_.n[0]) + " x " +
+                      std::to_string(grid_.n[1]) + " is over the limit of 4096^2 cells in x-y");
+    const int nx = static_cast<int>(grid_.n[0]), ny = static_cast<int>(grid_.n[1]);
+    const bool px = grid_.bc[0] == Boundary::Periodic, py = grid_.bc[1] == Boundary::Periodic;
+    const FmmGrid g{nx, ny, grid_.h(0), grid_.h(1), px, py};
+    try {
+      strokes_.emplace(mapkey,
+                       cached_stroke_field(resolve_path(base_dir_, file), g,
+                                           directed ? StrokeAngle::Directed : StrokeAngle::Axial));
+    } catch (const UserError& e) {
+      throw UserError("-" + key_ + " " + text_ + ": " + e.what());
+    }
+  }
+}
 
 std::string ValueSpec::where() const {
   return " at cell (" + std::to_string(static_cast<long>(i_)) + "," +

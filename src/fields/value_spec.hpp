@@ -15,6 +15,16 @@
 //             gnoise()               standard normal deviate of this cell
 //             png("file.png", lo, hi)  grey level of an image stretched over the domain
 //                                    (black = lo, white = hi, bilinear)
+//             strokes("file.json")   orientation (radians, mod pi, in (-pi/2, pi/2]) of the
+//                                    nearest stroke of a stroke file (.json or .svg, format in
+//                                    fields/strokes_file.hpp), extended from the strokes to
+//                                    every cell by fast marching (fields/strokes_field.hpp)
+//             strokes_directed("file.json")  the same as a direction along the drawing (mod 2 pi,
+//                                    in (-pi, pi]), for one-lobe anisotropies
+//             strokes_distance("file.json")  distance (domain units) to the nearest stroke
+//                                    (e.g. an initial condition: strokes_distance("s.json") < 2)
+//           Stroke fields are computed on the x-y grid (at most kMaxStrokeCells cells; in 3-D the
+//           same for every z) whole on every rank, once per file and grid (cached).
 //   "+-"    perturbation per cell: uniform in [v - a, v + a] (default) or Gaussian with standard
 //           deviation a ("gauss"); with "%", a is that percentage of |v| at the cell.
 // A value is one expression: a top-level '=' (assignment) or ',' (list) is refused.
@@ -31,6 +41,10 @@
 
 namespace mu {
 class Parser;
+}
+
+namespace morphogen {
+struct StrokeField;
 }
 
 namespace morphogen {
@@ -64,6 +78,7 @@ public:
 private:
   friend struct ValueSpecFunctions;
   double eval_expr();
+  void load_strokes(const std::string& expr);
   std::string where() const;
 
   std::string key_, text_, base_dir_;
@@ -79,6 +94,8 @@ private:
   double x_ = 0, y_ = 0, z_ = 0, i_ = 0, j_ = 0, k_ = 0, r_ = 0, theta_ = 0, t_ = 0;
   std::uint64_t cell_ = 0;
   std::map<std::string, io::GreyImage> images_;
+  // Stroke fields named in strokes(...) (key "file") and strokes_directed(...) (key "@file").
+  std::map<std::string, std::shared_ptr<const StrokeField>> strokes_;
 };
 
 } // namespace morphogen

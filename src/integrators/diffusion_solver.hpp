@@ -11,18 +11,25 @@
 // so L u + b equals the explicit scheme's Laplacian. The matrices A_s are assembled once per
 // (dt, theta) and reused. Solver: KSP CG with ICC on one rank and block Jacobi with ICC blocks
 // in parallel (GMRES with ILU for the non-symmetric first-order tensor masks), relative
-// tolerance 1e-10; every choice can be overridden with -diffusion_ksp_*
-// and -diffusion_pc_* options (e.g. -diffusion_pc_type mg for geometric multigrid on the
-// DMDA, -diffusion_pc_type hypre, or -diffusion_ksp_type richardson -diffusion_pc_type jacobi
-// or sor for Sanderson's relaxation). A diverged solve is reported with species, KSP reason and
-// iteration count.
+// tolerance 1e-8 (see kDefaultRtol in the .cpp); every choice can be overridden with
+// -diffusion_ksp_* and -diffusion_pc_* options (e.g. -diffusion_pc_type mg for geometric multigrid
+// on the DMDA, -diffusion_pc_type hypre, or -diffusion_ksp_type richardson -diffusion_pc_type
+// jacobi or sor for Sanderson's relaxation). A diverged solve is reported with species, KSP reason
+// and iteration count. -diffusion_solver auto|ksp|spectral: on one rank, a species whose matrix is
+// a periodic constant-coefficient stencil (checked numerically, spectral_diffusion.hpp) is solved
+// exactly by FFT instead (auto: wherever it applies and no -diffusion_ksp_*/-diffusion_pc_*
+// option is given, else KSP; spectral: an error where it does not apply). A species whose matrix is
+// later re-assembled (operator_changed) or modified goes back to KSP. The choice per species is
+// printed at setup.
 #pragma once
 
 #include "core/options.hpp"
 #include "grid/halo.hpp"
 #include "grid/stencil.hpp"
+#include "integrators/spectral_diffusion.hpp"
 #include "operators/operator_matrices.hpp"
 
+#include <cmath>
 #include <memory>
 #include <petscksp.h>
 #include <string>
@@ -44,12 +51,20 @@ public:
   // Solve for species s in place on the global Vec u. `step` is for messages.
   void solve(int s, Vec u, double dt, double theta, PetscInt step);
 
+  // Species s's matrix was re-assembled (solution-dependent coefficients, lagged per step):
+  // A_s is rebuilt on the next solve.
+  void operator_changed(int s) { assembled_dt_[s] = std::nan(""); }
+
+  // True while species s is solved by FFT (spectral_diffusion.hpp).
+  bool spectral(int s) const { return spectral_[s] != nullptr; }
   PetscInt last_iterations(int s) const { return iterations_[s]; }
   PetscInt total_iterations() const { return total_its_; }
   const OperatorMatrices& operators() const { return ops_; }
 
 private:
   void configure(int s);
+  void choose_spectral(const std::string& mode);
+  bool use_spectral(int s);
   void prepare_species(int s, double dt, double theta);
 
   const Grid& grid_;
@@ -57,6 +72,8 @@ private:
   std::vector<std::string> species_;
   std::vector<KSPH> ksp_; // (PETSc reference-counts the operators they hold)
   std::vector<MatH> A_;
+  std::vector<std::unique_ptr<SpectralDiffusion>> spectral_; // null: KSP
+  std::vector<Mat> spectral_mat_;                            // the M_s it was checked on
   std::vector<double> assembled_dt_, assembled_theta_;
   std::vector<PetscInt> iterations_;
   PetscInt total_its_ = 0;

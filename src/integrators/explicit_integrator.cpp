@@ -117,6 +117,7 @@ void ExplicitIntegrator::step(std::vector<VecH>& u, double t, double dt, PetscIn
     for (int s = 0; s < ns_; ++s)
       work_.push_back(grid_.create_local());
   update_ghosts(u);
+  if (terms_) terms_->refresh(u); // solution-dependent diffusion: coefficients of u^n
   if (others_.empty()) {
     sweep(u, work_, dt);
     if (constrain_after_sweep_) terms_->constrain(u);

@@ -1,12 +1,14 @@
 // The kernels instantiated from one reaction model: the fused explicit row sweep for each
 // stencil row layout and for scalar or per-cell parameters, the general explicit path's update
-// (diffusion precomputed) and the split integrator's per-cell reaction substep. Each model's
+// (diffusion precomputed) and the split integrator's per-cell reaction substep (the lockstep
+// Newton of reaction_lockstep_kernel.hpp). Each model's
 // table is instantiated in its own translation unit (integrators/kernels/<model>.cpp, declared
 // `extern template` here), so adding a kernel variant does not grow one file's compile time.
 #pragma once
 
 #include "integrators/explicit_kernel.hpp"
 #include "integrators/reaction_kernel.hpp"
+#include "integrators/reaction_lockstep_kernel.hpp"
 #include "integrators/split_integrator.hpp"
 #include "models/all_models.hpp"
 
@@ -51,8 +53,8 @@ template <class M> ModelKernels model_kernels() {
   k.explicit_row[1][2] = &explicit_row<M, 3, true, true>;
   k.explicit_pre[0] = &explicit_row_pre<M, false>;
   k.explicit_pre[1] = &explicit_row_pre<M, true>;
-  k.reaction_row[0] = &reaction_row<M, false>;
-  k.reaction_row[1] = &reaction_row<M, true>;
+  k.reaction_row[0] = &reaction_row_lockstep<M, false>; // 2-3 species: lockstep Newton
+  k.reaction_row[1] = &reaction_row_lockstep<M, true>;
   return k;
 }
 

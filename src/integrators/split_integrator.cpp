@@ -126,6 +126,9 @@ std::vector<Substep> split_substeps(SplitOrdering ordering) {
 }
 
 void SplitIntegrator::step(std::vector<VecH>& u, double t, double dt, PetscInt step) {
+  if (terms_) // solution-dependent diffusion: coefficients of u^n, lagged over the step
+    for (int s : terms_->refresh(u))
+      diffusion_.operator_changed(s);
   double t_reaction = t; // the reaction's (and sources') clock advances with its substeps
   for (const Substep& sub : substeps_) {
     if (sub.kind == Substep::Kind::Reaction) {

@@ -403,6 +403,13 @@ bool TsIntegrator::copy_state(std::vector<VecH>& u, bool to_x) {
 void TsIntegrator::step(std::vector<VecH>& u, double t, double dt, PetscInt step) {
   if (static_cast<PetscInt>(u.size()) != ns_)
     throw std::logic_error("TsIntegrator::step: wrong number of species vectors");
+  // Solution-dependent diffusion: coefficients of u^n, lagged over the step (the implicit
+  // operator and its Jacobian rebuilt from the re-assembled matrices).
+  if (!terms_.refresh(u).empty() && ops_) {
+    build_operator();
+    MG_PETSC(TSSetIJacobian(ts_, J_, J_, ijacobian_cb, this));
+    jac_shift_ = -1;
+  }
   // TS continues from its last solve (multistep schemes such as -ts_type bdf keep their
   // history) unless the state or the time changed in between (the clamp floor, a restart):
   // then it restarts the step, without reusing stage or history data.

@@ -299,21 +299,35 @@ struct Expressions {
     for (int s = 0; s < ns; ++s)
       r[s] = parsers[static_cast<size_t>(s)]->Eval();
   }
-  // Central differences, step cbrt(eps) (1 + |u_q|): error ~ eps^(2/3) relative.
+  // J[s * ns + q] = d R_s / d u_q: the user's expressions when given (jparsers, row-major),
+  // else central differences. ns <= kMaxModelSpecies (check_species): stack buffers only.
   void jacobian(const double* u, const double* p, double* J) {
-    std::vector<double> x(u, u + ns), rp(static_cast<size_t>(ns)), rm(static_cast<size_t>(ns));
+    if (!jparsers.empty()) {
+      std::copy(u, u + ns, vars.begin());
+      std::copy(p, p + np, vars.begin() + ns);
+      for (int e = 0; e < ns * ns; ++e)
+        J[e] = jparsers[static_cast<size_t>(e)]->Eval();
+      return;
+    }
+    fd_jacobian(u, p, J);
+  }
+  // Central differences, step cbrt(eps) (1 + |u_q|): error ~ eps^(2/3) relative.
+  void fd_jacobian(const double* u, const double* p, double* J) {
+    double x[kMaxModelSpecies], rp[kMaxModelSpecies], rm[kMaxModelSpecies];
+    std::copy(u, u + ns, x);
     const double c = std::cbrt(std::numeric_limits<double>::epsilon());
     for (int q = 0; q < ns; ++q) {
       const double h = c * (1.0 + std::fabs(u[q]));
-      x[static_cast<size_t>(q)] = u[q] + h;
-      rates(x.data(), p, rp.data());
-      x[static_cast<size_t>(q)] = u[q] - h;
-      rates(x.data(), p, rm.data());
-      x[static_cast<size_t>(q)] = u[q];
+      x[q] = u[q] + h;
+      rates(x, p, rp);
+      x[q] = u[q] - h;
+      rates(x, p, rm);
+      x[q] = u[q];
       for (int s = 0; s < ns; ++s)
-        J[s * ns + q] = (rp[static_cast<size_t>(s)] - rm[static_cast<size_t>(s)]) / (2 * h);
+        J[s * ns + q] = (rp[s] - rm[s]) / (2 * h);
     }
   }
+  std::vector<std::unique_ptr<mu::Parser>> jparsers; // d R_s / d u_q, row-major; empty: FD
 };
 
 void check_species(const CustomKinetics& spec) {
@@ -327,33 +341,64 @@ void check_species(const CustomKinetics& spec) {
                       "letter; not x, y, z, t or pi)");
     if (!seen.insert(n).second) throw UserError("-species " + n + ": given twice");
   }
+  if (spec.species.size() > static_cast<size_t>(kMaxModelSpecies))
+    throw UserError("-species: " + std::to_string(spec.species.size()) +
+                    " species, allowed at most " + std::to_string(kMaxModelSpecies));
+  const size_t nj = spec.species.size() * spec.species.size();
+  if (!spec.jac.empty() && (spec.jac.size() != nj || spec.jac_keys.size() != nj))
+    throw UserError("-jac_*: give all " + std::to_string(nj) + " Jacobian entries or none");
 }
 
-// Parses every expression and returns the names that are not species (the parameters).
+// Parses one expression (key: its option in messages) and adds the names in it that are not
+// species to params.
+std::unique_ptr<mu::Parser> parse_one(const std::string& text, const std::string& key,
+                                      const std::vector<std::string>& species,
+                                      std::vector<std::string>& params) {
+  auto P = std::make_unique<mu::Parser>();
+  if (text.find_first_not_of(" \t") == std::string::npos)
+    throw UserError(key + ": empty expression (on the command line a value that starts with "
+                          "'-' is read as an option name: write \"0 - k*a\" or \" -k*a\")");
+  try {
+    P->DefineConst("pi", M_PI);
+    P->SetExpr(text);
+    for (const auto& used : P->GetUsedVar()) { // parses; lists undefined names too
+      const std::string& n = used.first;
+      if (std::count(species.begin(), species.end(), n)) continue;
+      if (!std::count(params.begin(), params.end(), n)) params.push_back(n);
+    }
+  } catch (const mu::Parser::exception_type& e) {
+    throw UserError(key + " " + text + ": " + e.GetMsg());
+  }
+  return P;
+}
+
+// Parses every expression (rates, then the Jacobian's) and returns the names that are not
+// species (the parameters).
 std::vector<std::string> parse_all(const CustomKinetics& spec, Expressions& ex) {
   std::vector<std::string> params;
-  for (size_t s = 0; s < spec.species.size(); ++s) {
-    auto P = std::make_unique<mu::Parser>();
-    const std::string& text = spec.rates[s];
-    if (text.find_first_not_of(" \t") == std::string::npos)
-      throw UserError(spec.keys[s] +
-                      ": empty rate expression (on the command line a value that starts with "
-                      "'-' is read as an option name: write \"0 - k*a\" or \" -k*a\")");
-    try {
-      P->DefineConst("pi", M_PI);
-      P->SetExpr(text);
-      for (const auto& used : P->GetUsedVar()) { // parses; lists undefined names too
-        const std::string& n = used.first;
-        if (std::count(spec.species.begin(), spec.species.end(), n)) continue;
-        if (!std::count(params.begin(), params.end(), n)) params.push_back(n);
-      }
-    } catch (const mu::Parser::exception_type& e) {
-      throw UserError(spec.keys[s] + " " + text + ": " + e.GetMsg());
-    }
-    ex.parsers.push_back(std::move(P));
-  }
+  for (size_t s = 0; s < spec.species.size(); ++s)
+    ex.parsers.push_back(parse_one(spec.rates[s], spec.keys[s], spec.species, params));
+  for (size_t e = 0; e < spec.jac.size(); ++e)
+    ex.jparsers.push_back(parse_one(spec.jac[e], spec.jac_keys[e], spec.species, params));
   std::sort(params.begin(), params.end());
   return params;
+}
+
+// Binds every parser's names to ex.vars (species, then parameters).
+void bind_all(const CustomKinetics& spec, const std::vector<std::string>& all, Expressions& ex) {
+  auto bind = [&](mu::Parser& P, const std::string& key, const std::string& text) {
+    try {
+      for (size_t v = 0; v < all.size(); ++v)
+        P.DefineVar(all[v], &ex.vars[v]);
+      P.Eval(); // binds the variables
+    } catch (const mu::Parser::exception_type& e) {
+      throw UserError(key + " " + text + ": " + e.GetMsg());
+    }
+  };
+  for (size_t s = 0; s < ex.parsers.size(); ++s)
+    bind(*ex.parsers[s], spec.keys[s], spec.rates[s]);
+  for (size_t e = 0; e < ex.jparsers.size(); ++e)
+    bind(*ex.jparsers[e], spec.jac_keys[e], spec.jac[e]);
 }
 
 } // namespace
@@ -367,15 +412,7 @@ ModelInfo custom_model(const CustomKinetics& spec) {
   ex->vars.assign(static_cast<size_t>(ex->ns + ex->np), 0.0);
   std::vector<std::string> all = spec.species;
   all.insert(all.end(), params.begin(), params.end());
-  for (size_t s = 0; s < ex->parsers.size(); ++s) {
-    try {
-      for (size_t v = 0; v < all.size(); ++v)
-        ex->parsers[s]->DefineVar(all[v], &ex->vars[v]);
-      ex->parsers[s]->Eval(); // binds the variables
-    } catch (const mu::Parser::exception_type& e) {
-      throw UserError(spec.keys[s] + " " + spec.rates[s] + ": " + e.GetMsg());
-    }
-  }
+  bind_all(spec, all, *ex);
   // The bytecode is muParser's internal form: read as 2.3.3 to 2.3.5 write it (identical
   // ParseCmdCodeBulk), else evaluated cell by cell.
   ex->columns = ex->ns + ex->np <= Expressions::kMaxVars && mu::ParserVersion.rfind("2.3.", 0) == 0;

@@ -39,12 +39,12 @@ struct Layers {
   void jacobian(const double* u, const double* p, double* J) const {
     const int n = L * ns;
     std::fill(J, J + n * n, 0.0);
-    std::vector<double> block(static_cast<size_t>(ns * ns));
+    double block[kMaxModelSpecies * kMaxModelSpecies]; // ns <= kMaxModelSpecies (checked)
     for (int l = 0; l < L; ++l) {
-      base.jacobian(u + l * ns, p + l * np, block.data());
+      base.jacobian(u + l * ns, p + l * np, block);
       for (int a = 0; a < ns; ++a)
         for (int b = 0; b < ns; ++b)
-          J[(l * ns + a) * n + l * ns + b] = block[static_cast<size_t>(a * ns + b)];
+          J[(l * ns + a) * n + l * ns + b] = block[a * ns + b];
     }
     for (int s = 0; s < ns; ++s)
       for (int l = 0; l < L; ++l) {
@@ -72,6 +72,10 @@ struct Layers {
 ModelInfo layered_model(const ModelInfo& base, int layers) {
   if (layers < 2 || layers > 16)
     throw UserError("-layers " + std::to_string(layers) + ": allowed 2 to 16 (1: the model alone)");
+  if (base.nspecies > kMaxModelSpecies)
+    throw UserError("-layers " + std::to_string(layers) + ": model " + base.name + " has " +
+                    std::to_string(base.nspecies) + " species, allowed at most " +
+                    std::to_string(kMaxModelSpecies) + " per layer");
   auto names = std::make_shared<detail::RuntimeNames>();
   names->name = std::string(base.name);
   names->doc = std::to_string(layers) + " coupled layers of " + base.name + ": " + base.doc;

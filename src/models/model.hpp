@@ -18,6 +18,8 @@
 //   none
 #pragma once
 
+#include "core/host_device.hpp" // MG_HD
+
 #include <array>
 
 namespace morphogen {
@@ -37,11 +39,5 @@ struct SpeciesInfo {
   double init; // default initial value (the steady state where the paper starts from it)
   const char* doc;
 };
-
-#if defined(__CUDACC__)
-#define MG_HD __host__ __device__
-#else
-#define MG_HD
-#endif
 
 } // namespace morphogen

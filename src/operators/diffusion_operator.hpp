@@ -22,6 +22,7 @@
 #include "grid/stencil.hpp"
 #include "operators/diffusion_kernel.hpp"
 
+#include <utility>
 #include <vector>
 
 namespace morphogen {
@@ -35,6 +36,14 @@ public:
   // owned cells set. Collective.
   DiffusionOperator(const Grid& grid, const Halo& halo, DiffusionScheme scheme,
                     std::vector<std::vector<double>> coef);
+
+  // New coefficient arrays (same scheme and component count; owned cells set): ghosts, dual
+  // tensors and max_eigenvalue() are redone (solution-dependent coefficients,
+  // operators/state_diffusion.hpp). Collective.
+  void set_coefficients(std::vector<std::vector<double>> coef, const Halo& halo) {
+    coef_ = std::move(coef);
+    finish_setup(halo);
+  }
 
   const Grid& grid() const { return grid_; }
   DiffusionScheme scheme() const { return scheme_; }

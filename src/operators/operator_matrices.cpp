@@ -4,12 +4,13 @@ namespace morphogen {
 
 OperatorMatrices::OperatorMatrices(const Grid& grid, const Halo& halo, const Stencil& stencil,
                                    const std::vector<const DiffusionOperator*>& ops,
-                                   const std::vector<FaceValues>* dirichlet) {
+                                   const std::vector<FaceValues>* dirichlet)
+    : grid_(grid), halo_(halo), ops_(ops) {
   const int ns = static_cast<int>(ops.size());
   has_dirichlet_ = dirichlet != nullptr && !dirichlet->empty();
+  if (has_dirichlet_) dirichlet_ = *dirichlet;
   const std::vector<FaceValues>* dir = has_dirichlet_ ? dirichlet : nullptr;
   std::shared_ptr<LaplacianMatrix> shared;
-  const int nb = grid.dim() == 2 ? 9 : 27;
   for (int s = 0; s < ns; ++s) {
     const DiffusionOperator& op = *ops[s];
     symmetric_.push_back(op.symmetric());
@@ -20,26 +21,48 @@ OperatorMatrices::OperatorMatrices(const Grid& grid, const Halo& halo, const Ste
       scale_.push_back(op.D());
       continue;
     }
-    std::vector<FaceValues> own;
-    if (dir) own.push_back((*dir)[s]);
-    auto terms = [&op, nb](PetscInt i, PetscInt j, PetscInt k,
-                           std::vector<LaplacianMatrix::CellTerm>& out) {
-      double w[27];
-      op.weights(i, j, k, w);
-      for (int t = 0; t < nb; ++t)
-        if (w[t] != 0.0)
-          out.push_back({{t % 3 - 1, (t / 3) % 3 - 1, nb == 27 ? t / 9 - 1 : 0}, w[t]});
-    };
-    mat_.push_back(std::make_shared<LaplacianMatrix>(grid, halo, terms, 1, dir ? &own : nullptr));
+    mat_.push_back(own_matrix(s));
     index_.push_back(0);
     scale_.push_back(1.0);
   }
   pinned_M_.resize(static_cast<size_t>(ns));
   pinned_b_.resize(static_cast<size_t>(ns));
+  pin_rows_.resize(static_cast<size_t>(ns));
+  pin_values_.resize(static_cast<size_t>(ns));
+}
+
+std::shared_ptr<LaplacianMatrix> OperatorMatrices::own_matrix(int s) const {
+  const DiffusionOperator& op = *ops_[s];
+  const int nb = grid_.dim() == 2 ? 9 : 27;
+  std::vector<FaceValues> own;
+  if (has_dirichlet_ && !dirichlet_.empty()) own.push_back(dirichlet_[s]);
+  auto terms = [&op, nb](PetscInt i, PetscInt j, PetscInt k,
+                         std::vector<LaplacianMatrix::CellTerm>& out) {
+    double w[27];
+    op.weights(i, j, k, w);
+    for (int t = 0; t < nb; ++t)
+      if (w[t] != 0.0)
+        out.push_back({{t % 3 - 1, (t / 3) % 3 - 1, nb == 27 ? t / 9 - 1 : 0}, w[t]});
+  };
+  return std::make_shared<LaplacianMatrix>(grid_, halo_, terms, 1, own.empty() ? nullptr : &own);
+}
+
+void OperatorMatrices::reassemble(int s) {
+  if (ops_[s]->constant()) return;
+  mat_[s] = own_matrix(s);
+  if (pinned_M_[s]) {
+    pinned_M_[s].reset();
+    pinned_b_[s].reset();
+    const auto rows = pin_rows_[s];
+    const auto values = pin_values_[s];
+    pin(s, rows, values);
+  }
 }
 
 void OperatorMatrices::pin(int s, const std::vector<PetscInt>& rows,
                            const std::vector<double>& values) {
+  pin_rows_[s] = rows;
+  pin_values_[s] = values;
   MatH M;
   MG_PETSC(MatDuplicate(this->M(s), MAT_COPY_VALUES, M.out()));
   MG_PETSC(MatSetOption(M, MAT_KEEP_NONZERO_PATTERN, PETSC_TRUE));

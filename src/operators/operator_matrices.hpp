@@ -32,6 +32,9 @@ public:
   // coupling to the held values moves into b_s, whose pinned rows are 0, so K_s u = 0 there.
   // Collective.
   void pin(int s, const std::vector<PetscInt>& rows, const std::vector<double>& values);
+  // Re-assemble species s's own matrix from its operator (whose coefficients changed:
+  // solution-dependent diffusion, lagged), pinned cells held again. Collective.
+  void reassemble(int s);
   double scale(int s) const { return scale_[s]; }
   // False where the operator is not symmetric (first-order tensor masks): CG does not apply.
   bool symmetric(int s) const { return symmetric_[s]; }
@@ -39,6 +42,14 @@ public:
   bool has_dirichlet() const { return has_dirichlet_; }
 
 private:
+  std::shared_ptr<LaplacianMatrix> own_matrix(int s) const;
+
+  const Grid& grid_;
+  const Halo& halo_;
+  std::vector<const DiffusionOperator*> ops_;
+  std::vector<FaceValues> dirichlet_; // per species (empty: none)
+  std::vector<std::vector<PetscInt>> pin_rows_;
+  std::vector<std::vector<double>> pin_values_;
   std::vector<std::shared_ptr<LaplacianMatrix>> mat_;
   std::vector<int> index_; // which of the matrix's b vectors is species s's
   std::vector<double> scale_;

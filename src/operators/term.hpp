@@ -55,6 +55,12 @@ public:
   virtual bool linear() const { return false; }
   // True when the rates depend on t (time-dependent sources or parameters).
   virtual bool uses_time() const { return false; }
+  // Solution-dependent coefficients (polar a(theta), gradient-shaped tensors): recompute them
+  // from the species state u (ghosted local vectors, owned cells current; ghosts not needed).
+  // The explicit integrator calls it every step, the split and TS integrators at the start of
+  // each step (lagged). Returns true when the term changed (its matrix must be re-assembled).
+  // Collective.
+  virtual bool refresh(const std::vector<VecH>& /*u*/) const { return false; }
   // rates += T(state, t) on this rank's owned cells (state ghosts current when halo().width > 0).
   virtual void add_rates(const StateArrays& state, double t, const RateArrays& rates) const = 0;
 };

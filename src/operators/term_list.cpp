@@ -32,6 +32,18 @@ std::vector<const DiffusionOperator*> TermList::operators(int nspecies) const {
   return out;
 }
 
+std::vector<int> TermList::refresh(const std::vector<VecH>& u) const {
+  std::vector<int> changed;
+  if (!state_dependent_) return changed;
+  for (const auto& t : terms_)
+    if (t->refresh(u))
+      if (const auto* d = dynamic_cast<const DiffusionTerm*>(t.get())) {
+        changed.push_back(d->species());
+        if (matrices_) matrices_->reassemble(d->species());
+      }
+  return changed;
+}
+
 double TermList::stable_dt() const {
   double dt = std::numeric_limits<double>::infinity();
   for (const auto& t : terms_)

@@ -5,6 +5,7 @@
 
 #include "operators/constraints.hpp"
 #include "operators/diffusion_term.hpp"
+#include "operators/operator_matrices.hpp"
 
 #include <memory>
 
@@ -12,7 +13,11 @@ namespace morphogen {
 
 class TermList {
 public:
-  void add(std::unique_ptr<Term> t) { terms_.push_back(std::move(t)); }
+  // state_dependent: the term's coefficients follow the state (refresh() recomputes them).
+  void add(std::unique_ptr<Term> t, bool state_dependent = false) {
+    terms_.push_back(std::move(t));
+    state_dependent_ = state_dependent_ || state_dependent;
+  }
   void add(std::unique_ptr<Constraint> c) { constraints_.push_back(std::move(c)); }
 
   const std::vector<std::unique_ptr<Term>>& terms() const { return terms_; }
@@ -34,6 +39,14 @@ public:
       }
     return h;
   }
+  // Recompute the solution-dependent coefficients from u (Term::refresh); the matrices given to
+  // use_matrices (if any) are re-assembled for the species whose operator changed. Returns
+  // those species. Collective.
+  std::vector<int> refresh(const std::vector<VecH>& u) const;
+  // The run's assembled operators (split, TS), kept in step with refresh(); null: none.
+  void use_matrices(OperatorMatrices* m) { matrices_ = m; }
+  // True when some term has solution-dependent coefficients.
+  bool any_state_dependent() const { return state_dependent_; }
   // Largest stable forward-Euler dt of the diffusion terms (min over terms). Collective.
   double stable_dt() const;
   // The pinned-cells constraint, or null.
@@ -46,6 +59,8 @@ public:
 private:
   std::vector<std::unique_ptr<Term>> terms_;
   std::vector<std::unique_ptr<Constraint>> constraints_;
+  OperatorMatrices* matrices_ = nullptr;
+  bool state_dependent_ = false;
 };
 
 } // namespace morphogen

@@ -199,8 +199,9 @@ int run_sweep(int* argc, char*** argv, const std::vector<OptionsFileArg>& option
   if (*argc < 2 || (*argv)[1][0] == '-')
     throw UserError("sweep: needs a deck (morphogen sweep DECK.yaml [-option value ...])");
   const std::string deck = (*argv)[1];
-  const std::string base_dir = load_deck(argc, argv, options_files);
+  const std::string deck_dir = load_deck(argc, argv, options_files);
   Options sopt(world);
+  const std::string base_dir = read_deck_dir(sopt, deck_dir);
   if (!sopt.is_set("sweep_axes"))
     throw UserError("deck " + deck +
                     ": no sweep: section (sweep: {axes: [params_F, ...], params_F: "

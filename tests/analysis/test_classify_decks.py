@@ -30,6 +30,10 @@ EXPECTED = {
     "brusselator_fixed_rows": {"a": "stripes", "b": "stripes"},  # Fig. 20 left: pinned rows
     "brusselator_spot_on_spot": {"b1": "spots", "b2": "spots"},  # Fig. 10: coupled layers
     "brusselator_aligned_spots": {"a2": "stripes", "b2": "stripes"},  # Fig. 21: aligned by mu
+    "witkin_kass_weave": {"p1": "mixed"},      # WK Fig. 3-4e: threads of two orientations
+    "witkin_kass_triweave": {"p1": "mixed"},   # WK Fig. 3-2b: three-direction mesh
+    "witkin_kass_coral": {"p1": "stripes"},    # WK Fig. 3-1c: five-direction branching threads
+    "witkin_kass_replication": {"p1": "mixed"},  # WK Fig. 3-2d: triweave on a 64^2 torus
 }
 
 

@@ -7,6 +7,9 @@
 //   - the runtime kernels' explicit row and backward-Euler reaction row equal the compiled
 //     model's kernels (bitwise for the layer-free model, tolerance 1e-13 otherwise);
 //   - bad names and expressions are one-line UserErrors naming the option;
+//   - a Jacobian by expressions (Gray-Scott's) equals the compiled one to round-off and the
+//     central differences to 1e-8, and is what the model returns; the central differences are
+//     exactly the textbook formula (bitwise); a partial Jacobian or 17 species are refused;
 //   - the custom model's row rates (ModelInfo::rates_row: muParser's bytecode evaluated per row)
 //     equal its per-cell rates bitwise, for rows of several lengths, scalar and per-cell
 //     parameters, every kind of token, and the cell-by-cell fallback (if-then-else); the
@@ -16,12 +19,14 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "core/user_error.hpp"
 #include "integrators/runtime_kernels.hpp"
 #include "models/brusselator.hpp"
+#include "models/gray_scott.hpp"
 #include "models/model_info.hpp"
 #include "models/runtime_model.hpp"
 
@@ -92,6 +97,90 @@ TEST(CustomModel, CoordinatesAndTimeAreParametersWithExpressionDefaults) {
   double r;
   m.rates(&u, p, &r);
   EXPECT_DOUBLE_EQ(r, -0.5 * 3 * 2 + 0.25);
+}
+
+// Gray-Scott (models/gray_scott.hpp) as expressions, with its Jacobian by expressions or not.
+CustomKinetics gray_scott_expressions(bool with_jacobian) {
+  CustomKinetics k{
+      {"a", "b"}, {"s*(a^2*b - (F + k)*a)", "s*(-a^2*b + F*(1 - b))"}, {"-rate_a", "-rate_b"}};
+  if (with_jacobian) {
+    k.jac = {"s*(2*a*b - (F + k))", "s*a^2", "-2*s*a*b", "-s*(a^2 + F)"};
+    k.jac_keys = {"-jac_a_a", "-jac_a_b", "-jac_b_a", "-jac_b_b"};
+  }
+  return k;
+}
+
+// The Jacobian by expressions equals the compiled model's analytic one to round-off (the same
+// formulas, evaluated by muParser) and the central differences of the same rates to 1e-8
+// (their error ~ eps^(2/3)); the parameters are those of the rates (F, k, s).
+TEST(CustomModel, JacobianByExpressionsMatchesAnalyticAndFiniteDifferences) {
+  const ModelInfo ex = custom_model(gray_scott_expressions(true));
+  const ModelInfo fd = custom_model(gray_scott_expressions(false));
+  ASSERT_EQ(ex.nparams, 3);
+  const double p[3] = {0.037, 0.06, 1.3};
+  for (const auto& u : std::vector<std::vector<double>>{{0.25, 0.5}, {0, 1}, {0.9, 0.02}}) {
+    double Je[4], Jf[4], Jc[4];
+    ex.jacobian(u.data(), p, Je);
+    fd.jacobian(u.data(), p, Jf);
+    models::GrayScott::jacobian(u.data(), p, Jc);
+    for (int q = 0; q < 4; ++q) {
+      EXPECT_NEAR(Je[q], Jc[q], 1e-14 * (1 + std::fabs(Jc[q]))) << q;
+      EXPECT_NEAR(Je[q], Jf[q], 1e-8 * (1 + std::fabs(Jc[q]))) << q;
+    }
+  }
+  // The expressions are what the model returns (not differences): a deliberately other one.
+  CustomKinetics odd = gray_scott_expressions(true);
+  odd.jac[1] = "7 + q";
+  const ModelInfo m = custom_model(odd);
+  ASSERT_EQ(m.nparams, 4); // F, k, q, s: a name only in the Jacobian is a parameter too
+  const double u[2] = {0.3, 0.4}, pq[4] = {0.04, 0.06, 0.5, 1.0};
+  double J[4];
+  m.jacobian(u, pq, J);
+  EXPECT_EQ(J[1], 7.5);
+}
+
+// The central differences (stack buffers) are exactly (R(u + h e_q) - R(u - h e_q)) / 2h with
+// h = cbrt(eps) (1 + |u_q|), computed here from the model's own rates: bitwise.
+TEST(CustomModel, FiniteDifferenceJacobianIsCentralDifferencesBitwise) {
+  const ModelInfo m = custom_model({{"a", "b", "c"},
+                                    {"a*b - c^3", "sin(a)*exp(b) + c", "a/(1 + b^2) - 2*c*k"},
+                                    {"-rate_a", "-rate_b", "-rate_c"}});
+  const double u[3] = {0.7, -1.3, 2.1}, p[1] = {0.4};
+  double J[9];
+  m.jacobian(u, p, J);
+  const double c = std::cbrt(std::numeric_limits<double>::epsilon());
+  for (int q = 0; q < 3; ++q) {
+    const double h = c * (1.0 + std::fabs(u[q]));
+    double x[3] = {u[0], u[1], u[2]}, rp[3], rm[3];
+    x[q] = u[q] + h;
+    m.rates(x, p, rp);
+    x[q] = u[q] - h;
+    m.rates(x, p, rm);
+    for (int s = 0; s < 3; ++s)
+      EXPECT_EQ(J[s * 3 + q], (rp[s] - rm[s]) / (2 * h)) << s << "," << q;
+  }
+}
+
+TEST(CustomModel, PartialJacobianAndTooManySpeciesAreUserErrors) {
+  CustomKinetics k = gray_scott_expressions(true);
+  k.jac.pop_back();
+  k.jac_keys.pop_back();
+  EXPECT_THROW(custom_model(k), UserError);
+  k = gray_scott_expressions(true);
+  k.jac[2] = "a*(";
+  try {
+    custom_model(k);
+    ADD_FAILURE() << "no error";
+  } catch (const UserError& e) {
+    EXPECT_NE(std::string(e.what()).find("-jac_b_a a*("), std::string::npos) << e.what();
+  }
+  CustomKinetics many;
+  for (int s = 0; s <= kMaxModelSpecies; ++s) {
+    many.species.push_back("s" + std::to_string(s));
+    many.rates.push_back("0");
+    many.keys.push_back("-rate_s" + std::to_string(s));
+  }
+  EXPECT_THROW(custom_model(many), UserError);
 }
 
 // Bitwise equality of doubles (NaN == NaN of the same payload).
