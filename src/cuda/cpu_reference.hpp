@@ -23,6 +23,24 @@ template <int NR> CellStencil<NR> cell_stencil(const RowStencil& rows, const Gho
   return st;
 }
 
+// Ghosted arrays of model M's homogeneous steady state (the species' initial values where it has
+// none) plus 0.05 wiggle(s, i, j, k) on each owned cell, wiggle in [-0.5, 0.5].
+template <class M, class Wiggle>
+std::vector<std::vector<double>> perturbed_start(const GhostedBox& g, const double* p,
+                                                 Wiggle wiggle) {
+  double u0[M::nspecies];
+  if (!M::steady_state(p, u0))
+    for (int s = 0; s < M::nspecies; ++s)
+      u0[s] = M::species[s].init;
+  std::vector<std::vector<double>> u(M::nspecies, std::vector<double>(g.size(), 0.0));
+  for (int s = 0; s < M::nspecies; ++s)
+    for (int k = 0; k < g.n[2]; ++k)
+      for (int j = 0; j < g.n[1]; ++j)
+        for (int i = 0; i < g.n[0]; ++i)
+          u[s][g.index(i, j, k)] = u0[s] + 0.05 * wiggle(s, i, j, k);
+  return u;
+}
+
 // Periodic ghosts of one species' ghosted array on the host (x, then y, then z).
 inline void fill_ghosts_host(const GhostedBox& g, double* u) {
   for (int axis = 0; axis < g.dim; ++axis) {

@@ -55,19 +55,10 @@ template <class M> CellCoefficients<M::nspecies, M::nparams> coefficients(double
 
 template <class M>
 std::vector<std::vector<double>> initial_state(const GhostedBox& g, const double* p) {
-  double u0[M::nspecies];
-  if (!M::steady_state(p, u0))
-    for (int s = 0; s < M::nspecies; ++s)
-      u0[s] = M::species[s].init;
-  std::vector<std::vector<double>> u(M::nspecies, std::vector<double>(g.size(), 0.0));
-  for (int s = 0; s < M::nspecies; ++s)
-    for (int k = 0; k < g.n[2]; ++k)
-      for (int j = 0; j < g.n[1]; ++j)
-        for (int i = 0; i < g.n[0]; ++i) {
-          const auto cell = static_cast<std::uint64_t>(i + g.n[0] * (j + g.n[1] * k));
-          u[s][g.index(i, j, k)] = u0[s] + 0.05 * (rng::uniform(7, s, cell) - 0.5);
-        }
-  return u;
+  return perturbed_start<M>(g, p, [&g](int s, int i, int j, int k) {
+    const auto cell = static_cast<std::uint64_t>(i + g.n[0] * (j + g.n[1] * k));
+    return rng::uniform(7, s, cell) - 0.5;
+  });
 }
 
 template <int NS> struct DeviceState {

@@ -39,17 +39,9 @@ RowStencil rows_of(int dim, bool box) {
 }
 
 template <class M> std::vector<std::vector<double>> start(const GhostedBox& g, const double* p) {
-  double u0[M::nspecies];
-  if (!M::steady_state(p, u0))
-    for (int s = 0; s < M::nspecies; ++s)
-      u0[s] = M::species[s].init;
-  std::vector<std::vector<double>> u(M::nspecies, std::vector<double>(g.size(), 0.0));
-  for (int s = 0; s < M::nspecies; ++s)
-    for (int k = 0; k < g.n[2]; ++k)
-      for (int j = 0; j < g.n[1]; ++j)
-        for (int i = 0; i < g.n[0]; ++i)
-          u[s][g.index(i, j, k)] = u0[s] + 0.05 * std::sin(0.7 * i + 1.3 * j + 0.4 * k + s);
-  return u;
+  return perturbed_start<M>(g, p, [](int s, int i, int j, int k) {
+    return 0.5 * std::sin(0.7 * i + 1.3 * j + 0.4 * k + s);
+  });
 }
 
 template <class M, int NR, bool Box> void compare(int dim, int n) {
