@@ -19,6 +19,18 @@ def run(args, cwd, ranks=1, timeout=300):
     return subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, timeout=timeout, env=env)
 
 
+def error_lines(proc):
+    """Non-empty stderr lines of morphogen itself, warnings left out (mpiexec appends its own
+    banner, framed by dashed lines, when a rank exits non-zero)."""
+    lines = []
+    for l in proc.stderr.splitlines():
+        if l.startswith("-----"):
+            break
+        if l.strip() and not l.startswith("morphogen: warning:"):
+            lines.append(l)
+    return lines
+
+
 @pytest.fixture
 def workdir(tmp_path):
     return tmp_path

@@ -7,12 +7,10 @@ non-finite velocity, a dt whose back-trace exceeds the widest halo, a dt too lar
 the step where it does, before any output). A valid advected run writes the velocity into its
 snapshots and options_used.yaml reproduces it."""
 import os
-import subprocess
 
 import pytest
+from conftest import error_lines, run
 
-EXE = os.environ.get("MORPHOGEN_EXE", os.path.join(os.path.dirname(__file__), "../../build/morphogen"))
-MPIEXEC = os.environ.get("MORPHOGEN_MPIEXEC", "mpiexec")
 
 GRID = ["-model", "gray_scott", "-grid_n", "32,32", "-grid_L", "32", "-steps", "5", "-dt", "0.5",
         "-summary", "false"]
@@ -50,27 +48,6 @@ CASES = [
      ["-velocity_x 1 + t", "at t = 1.25", "reaches 3 cells", "advection halo (2 cells, sized from "
       "the velocity at the start)", "-advection_halo 3"]),
 ]
-
-
-def run(args, cwd, ranks=1, timeout=120):
-    cmd = [EXE] + list(args)
-    if ranks > 1:
-        cmd = [MPIEXEC, "--oversubscribe", "-n", str(ranks)] + cmd
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-               OMPI_MCA_rmaps_base_oversubscribe="1")
-    return subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, timeout=timeout, env=env)
-
-
-def error_lines(proc):
-    """Non-empty stderr lines of morphogen itself (mpiexec appends its own banner, framed by
-    dashed lines, when a rank exits non-zero)."""
-    lines = []
-    for l in proc.stderr.splitlines():
-        if l.startswith("-----"):
-            break
-        if l.strip():
-            lines.append(l)
-    return lines
 
 
 @pytest.mark.parametrize("ranks", [1, 2])

@@ -4,7 +4,7 @@ allowed, and leaves an existing output directory untouched. Run on 1 and 2 ranks
 import os
 
 import pytest
-from conftest import run
+from conftest import error_lines, run
 
 CASES = [
     # (id, args, substrings the one-line error must contain)
@@ -55,16 +55,6 @@ CASES = [
 ]
 
 
-def error_lines(proc):
-    """Non-empty stderr lines of morphogen itself (mpiexec appends its own banner, framed by
-    dashed lines, when a rank exits non-zero)."""
-    lines = []
-    for l in proc.stderr.splitlines():
-        if l.startswith("-----"):
-            break
-        if l.strip() and not l.startswith("morphogen: warning:"):  # e.g. a stiff reaction's dt
-            lines.append(l)
-    return lines
 
 
 @pytest.mark.parametrize("ranks", [1, 2])

@@ -3,12 +3,10 @@ never runs: each case exits non-zero with exactly one error line naming the opti
 what is allowed, and leaves an existing output directory untouched. A valid polar run records its
 options in options_used.yaml, which reproduces it bitwise, and -help lists the options."""
 import os
-import subprocess
 
 import pytest
+from conftest import error_lines, run
 
-EXE = os.environ.get("MORPHOGEN_EXE", os.path.join(os.path.dirname(__file__), "../../build/morphogen"))
-MPIEXEC = os.environ.get("MORPHOGEN_MPIEXEC", "mpiexec")
 
 GRID = ["-grid_n", "32,32", "-steps", "5"]
 POLAR = GRID + ["-diffusion", "polar"]
@@ -48,25 +46,6 @@ CASES = [
     ("shaped_v_time", SHAPED + ["-shaped_vx", "t", "-shaped_vy", "1"], ["-shaped_vx", "time-dependent"]),
     ("shaped_key_without_shaped", GRID + ["-shaped_I", "0.1"], ["-shaped_I", "unknown option"]),
 ]
-
-
-def run(args, cwd, ranks=1, timeout=120):
-    cmd = [EXE] + list(args)
-    if ranks > 1:
-        cmd = [MPIEXEC, "--oversubscribe", "-n", str(ranks)] + cmd
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-               OMPI_MCA_rmaps_base_oversubscribe="1")
-    return subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, timeout=timeout, env=env)
-
-
-def error_lines(proc):
-    lines = []
-    for l in proc.stderr.splitlines():
-        if l.startswith("-----"):
-            break
-        if l.strip():
-            lines.append(l)
-    return lines
 
 
 @pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])

@@ -10,7 +10,7 @@ its file relative to the deck."""
 import os
 
 import pytest
-from conftest import run, SOURCE
+from conftest import SOURCE, error_lines, run
 
 GRID = ["-model", "turing", "-grid_n", "32,32", "-grid_bc", "neumann", "-steps", "1",
         "-png_every", "0", "-summary", "false"]
@@ -51,14 +51,6 @@ CASES = [
 ]
 
 
-def error_lines(proc):
-    lines = []
-    for l in proc.stderr.splitlines():
-        if l.startswith("-----"):
-            break
-        if l.strip() and not l.startswith("morphogen: warning:"):
-            lines.append(l)
-    return lines
 
 
 # Every case on 1 rank, a few on 2 (each rank reads the file and fails alike).
