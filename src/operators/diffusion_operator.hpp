@@ -39,9 +39,10 @@ public:
 
   // New coefficient arrays (same scheme and component count; owned cells set): ghosts, dual
   // tensors and max_eigenvalue() are redone (solution-dependent coefficients,
-  // operators/state_diffusion.hpp). Collective.
-  void set_coefficients(std::vector<std::vector<double>> coef, const Halo& halo) {
-    coef_ = std::move(coef);
+  // operators/state_diffusion.hpp). The arrays are swapped: coef gets the previous ones back,
+  // for the caller to reuse without allocating. Collective.
+  void set_coefficients(std::vector<std::vector<double>>& coef, const Halo& halo) {
+    coef_.swap(coef);
     finish_setup(halo);
   }
 

@@ -45,7 +45,11 @@ void StateDiffusionTerm::refresh_from(const double* u) const {
   double ih[3];
   for (int d = 0; d < dim; ++d)
     ih[d] = 0.5 / grid.spec().h(d);
-  std::vector<std::vector<double>> coef(static_cast<size_t>(nc), std::vector<double>(ng, 0.0));
+  // The previous step's arrays, reused (same zero start as fresh ones, no allocation per step).
+  std::vector<std::vector<double>>& coef = coef_scratch_;
+  coef.resize(static_cast<size_t>(nc));
+  for (auto& a : coef)
+    a.assign(ng, 0.0);
   const Box& ob = grid.owned();
   double g[3] = {0, 0, 0}, cv[6];
   for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
@@ -58,7 +62,7 @@ void StateDiffusionTerm::refresh_from(const double* u) const {
         for (int q = 0; q < nc; ++q)
           coef[q][c] = cv[q];
       }
-  mop_.set_coefficients(std::move(coef), halo_);
+  mop_.set_coefficients(coef, halo_);
 }
 
 } // namespace morphogen

@@ -51,6 +51,7 @@ private:
   const Halo& halo_;
   std::unique_ptr<CoefficientRule> rule_;
   mutable std::vector<double> buf_;
+  mutable std::vector<std::vector<double>> coef_scratch_; // next coefficients (reused)
 };
 
 } // namespace morphogen
