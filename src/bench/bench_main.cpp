@@ -13,6 +13,7 @@
 //   roofline_fraction=<2-D fraction>
 #include "app/pattern_summary.hpp"
 #include "app/simulation.hpp"
+#include "bench/bench_scaling.hpp"
 #include "core/user_error.hpp"
 #include "integrators/reaction_lockstep_kernel.hpp"
 
@@ -52,6 +53,7 @@ double stream_triad(MPI_Comm comm, size_t n, int reps) {
 
 struct Result {
   double cups = 0, halo_s = 0, g2l_s = 0;
+  ProbeRun probe; // cups again, with the stencil and species the halo moves
 };
 
 // Diffusion options of the general-path cases (cleared before each case).
@@ -88,6 +90,8 @@ Result bench_explicit(MPI_Comm comm, Options& opt, const std::string& n, int ste
     best = std::min(best, MPI_Wtime() - t0);
   }
   r.cups = static_cast<double>(sim.grid().global_cells()) * steps / best;
+  r.probe = {r.cups, sim.grid().spec().stencil_width, sim.grid().spec().box_stencil,
+             static_cast<int>(sim.species().size())};
   // Halo-only update vs. PETSc's global-to-local copy, per species per step.
   const int reps = 50;
   MPI_Barrier(comm);
@@ -354,6 +358,9 @@ int run(MPI_Comm comm) {
                "1024^2, and the Brusselator deck (issue 13 part 1)");
   const double deck_T = opt.real("bench_brusselator_T", 125.0, 0.0, 1e6,
                                  "simulated time of the Brusselator deck comparison (0: skip)");
+  const bool with_scaling = opt.flag(
+      "bench_scaling", true,
+      "strong scaling on this node (1 rank vs all) and the weak-scaling model for clusters");
   const bool only_implicit =
       opt.flag("bench_only_implicit", false, "only the implicit-vs-explicit section");
   const double bw = stream_triad(comm, static_cast<size_t>(mb) * 1024 * 1024 / 8, 10);
@@ -443,6 +450,18 @@ int run(MPI_Comm comm) {
                   name.c_str(), sr.seconds_per_step, sr.its_per_solve,
                   sr.seconds_per_step / explicit_s);
     }
+  }
+  if (with_scaling) {
+    const ScalingProbes probe = {
+        [&](MPI_Comm c) { return stream_triad(c, static_cast<size_t>(mb) * 1024 * 1024 / 8, 10); },
+        [&](MPI_Comm c, Options& o, const std::string& n) {
+          set_case({});
+          return bench_explicit(
+                     c, o, n,
+                     static_cast<int>(std::count(n.begin(), n.end(), ',') == 2 ? steps3 : steps2))
+              .probe;
+        }};
+    bench_scaling(comm, opt, probe);
   }
   PetscPrintf(comm, "roofline_fraction=%.3f\n", r2.cups / roof);
   return 0;
