@@ -98,7 +98,7 @@ double mean_diagonal(const DiffusionOperator& op, const Grid& grid) {
 }
 
 // -surface_x/y/z: the parametric surface x(u, v) the texture is grown for (2-D).
-std::unique_ptr<SurfaceMap> read_surface(Options& opt, const GridSpec& spec) {
+std::shared_ptr<SurfaceMap> read_surface(Options& opt, const GridSpec& spec) {
   const char* axes[3] = {"surface_x", "surface_y", "surface_z"};
   bool any = false;
   for (const char* a : axes)
@@ -118,8 +118,77 @@ std::unique_ptr<SurfaceMap> read_surface(Options& opt, const GridSpec& spec) {
                       std::string("parametric surface, ") + "xyz"[a] +
                           " component as an expression of u, v (the grid's x, y), Lx, Ly: the "
                           "tensor is corrected for the surface metric (Witkin-Kass section 4)");
-  return std::make_unique<SurfaceMap>(e[0], e[1], e[2], spec.L[0], spec.L[1]);
+  return std::make_shared<SurfaceMap>(e[0], e[1], e[2], spec.L[0], spec.L[1]);
 }
+
+// The tensor components D sigma at every owned cell at time t into c (ghosted arrays); an
+// invalid tensor is a one-line error naming the keys, the cell, the values (and t when it
+// depends on t). Collective.
+struct TensorFill {
+  const Grid* grid;
+  std::shared_ptr<ValueSpec> D;
+  std::vector<std::shared_ptr<ValueSpec>> vals;
+  TensorKeys tk;
+  std::shared_ptr<SurfaceMap> surface;
+  std::string name;
+
+  void operator()(double t, std::vector<std::vector<double>>& c) const {
+    const int dim = grid->dim(), nc = dim == 2 ? 3 : 6;
+    const Box& ob = grid->owned();
+    std::string err;
+    double v[6], s[6];
+    try {
+      for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2] && err.empty(); ++k)
+        for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1] && err.empty(); ++j)
+          for (PetscInt i = ob.s[0]; i < ob.s[0] + ob.m[0]; ++i) {
+            for (size_t q = 0; q < vals.size(); ++q)
+              v[q] = vals[q]->at_cell(i, j, k, t);
+            if (tk.components)
+              std::copy(v, v + nc, s);
+            else
+              principal_to_components(dim, v, s);
+            if (surface) // the tensor is meant on the surface: correct it for the map's metric
+              surface->corrected_tensor(grid->centre(0, i), grid->centre(1, j), s, s);
+            const double d = D->at_cell(i, j, k, t);
+            if (!valid(dim, d, s)) {
+              err = message(i, j, k, d, v, t);
+              break;
+            }
+            const PetscInt gi = grid->local_index(i, j, k);
+            for (int q = 0; q < nc; ++q)
+              c[q][gi] = d * s[q];
+          }
+    } catch (const UserError& e) {
+      err = e.what();
+    }
+    throw_if_any(grid->comm(), err);
+  }
+
+  static bool valid(int dim, double d, const double* s) {
+    const bool pd = dim == 2 ? tensor_positive_definite<2>(s) : tensor_positive_definite<3>(s);
+    bool finite = std::isfinite(d);
+    for (int q = 0; q < (dim == 2 ? 3 : 6); ++q)
+      finite = finite && std::isfinite(s[q]);
+    return pd && finite && d >= 0;
+  }
+
+  std::string message(PetscInt i, PetscInt j, PetscInt k, double d, const double* v,
+                      double t) const {
+    bool timed = D->uses_time();
+    for (const auto& q : vals)
+      timed = timed || q->uses_time();
+    std::ostringstream m;
+    m.precision(6);
+    m << (d >= 0 && std::isfinite(d) ? "-" + tk.keys[0] + ".." + tk.keys.back() : "-" + D->key())
+      << ": the diffusion tensor of " << name << " must be positive definite with D_" << name
+      << " >= 0 at every cell; at cell " << cell_text(i, j, k, grid->dim());
+    if (timed) m << " at t = " << t;
+    m << " D = " << d << ", tensor (" << (tk.components ? "components" : "principal values") << ")";
+    for (size_t q = 0; q < vals.size(); ++q)
+      m << " " << tk.keys[q] << " = " << v[q];
+    return m.str();
+  }
+};
 
 } // namespace
 
@@ -138,7 +207,8 @@ DiffusionSetup read_diffusion(Options& opt, const Grid& grid, const Halo& halo,
   const std::string dtext =
       opt.string(dkey, format_double(si.D),
                  "diffusion coefficient of " + name + " (" + si.doc +
-                     "): a number, or a field (expression, 'v +- a%', png(...))");
+                     "): a number, or a field (expression, 'v +- a%', png(...)); may use t "
+                     "(re-evaluated once per step, or at the TS stage times)");
   {
     // A plain number (inf included) is range-checked as a number.
     char* end = nullptr;
@@ -146,11 +216,16 @@ DiffusionSetup read_diffusion(Options& opt, const Grid& grid, const Halo& halo,
     if (end && end != dtext.c_str() && *end == '\0' && !(v >= 0 && v <= kMaxReal))
       throw UserError("-" + dkey + " " + dtext + ": out of range, " + allowed_range(0, kMaxReal));
   }
-  ValueSpec D(dkey, dtext, spec, seed, base_dir);
-  if (D.uses_time())
-    throw UserError("-" + dkey + " " + D.text() + ": time-dependent diffusion is not supported");
-  if (const std::string kind = read_diffusion_kind(opt, name); kind == "polar" || kind == "shaped")
+  auto Dp = std::make_shared<ValueSpec>(dkey, dtext, spec, seed, base_dir);
+  ValueSpec& D = *Dp;
+  if (const std::string kind = read_diffusion_kind(opt, name);
+      kind == "polar" || kind == "shaped") {
+    if (D.uses_time())
+      throw UserError("-" + dkey + " " + D.text() + ": a time-dependent D_" + name +
+                      " is not supported with -diffusion_" + name + " " + kind +
+                      " (solution-dependent coefficients); allowed with iso and tensor");
     return read_state_diffusion(opt, grid, halo, name, kind, D, seed, base_dir);
+  }
   DiffusionSetup out;
   if (D.is_constant() && !tensor) {
     const double v = D.constant_value();
@@ -161,7 +236,6 @@ DiffusionSetup read_diffusion(Options& opt, const Grid& grid, const Halo& halo,
     out.D_mean = v;
     return out;
   }
-  const Box& ob = grid.owned();
   const size_t nghost = static_cast<size_t>(grid.ghosted().size());
   if (!tensor) {
     std::vector<std::vector<double>> c(1, std::vector<double>(nghost, 0.0));
@@ -169,6 +243,12 @@ DiffusionSetup read_diffusion(Options& opt, const Grid& grid, const Halo& halo,
     out.op = std::make_unique<DiffusionOperator>(grid, halo, DiffusionScheme::IsotropicField,
                                                  std::move(c));
     out.D_mean = mean_diagonal(*out.op, grid);
+    if (D.uses_time()) {
+      out.components = 1;
+      out.timed = [Dp, g = &grid](double t, std::vector<std::vector<double>>& coef) {
+        fill_field(*g, *Dp, coef[0].data(), ArrayLayout::Ghosted, 0.0, kMaxReal, t);
+      };
+    }
     return out;
   }
   const std::string scheme =
@@ -176,70 +256,34 @@ DiffusionSetup read_diffusion(Options& opt, const Grid& grid, const Halo& halo,
                  "tensor discretisation: second_order (conservative, with the tensor-gradient "
                  "terms; Sanderson eq. 17) or first_order (Witkin-Kass constant masks)");
   const TensorKeys tk = tensor_keys(opt, dim, name);
-  std::vector<std::unique_ptr<ValueSpec>> vals;
+  TensorFill fill{&grid, Dp, {}, tk, nullptr, name};
+  bool timed = D.uses_time();
   for (size_t q = 0; q < tk.keys.size(); ++q) {
     const std::string help =
-        tk.components ? "diffusion tensor component (times D_S); a value"
+        tk.components ? "diffusion tensor component (times D_S); a value (may use t)"
         : tk.keys[q].find("theta") != std::string::npos
-            ? "angle of the first principal direction from the x axis (radians); a value"
+            ? "angle of the first principal direction from the x axis (radians); a value (may "
+              "use t)"
         : tk.keys[q].find("phi") != std::string::npos
             ? "polar angle of the first principal direction from the z axis (radians)"
-            : "principal diffusivity (times D_S, > 0); a value";
-    vals.push_back(std::make_unique<ValueSpec>(tk.keys[q], opt.string(tk.keys[q], tk.defs[q], help),
-                                               spec, seed, base_dir));
-    if (vals.back()->uses_time())
-      throw UserError("-" + tk.keys[q] + " " + vals.back()->text() +
-                      ": time-dependent tensors are not supported");
+            : "principal diffusivity (times D_S, > 0); a value (may use t)";
+    fill.vals.push_back(std::make_shared<ValueSpec>(
+        tk.keys[q], opt.string(tk.keys[q], tk.defs[q], help), spec, seed, base_dir));
+    timed = timed || fill.vals.back()->uses_time();
   }
   const int nc = dim == 2 ? 3 : 6;
-  std::unique_ptr<SurfaceMap> surface = read_surface(opt, spec);
+  fill.surface = read_surface(opt, spec);
   std::vector<std::vector<double>> c(static_cast<size_t>(nc), std::vector<double>(nghost, 0.0));
-  std::string err;
-  double v[6], s[6];
-  try {
-    for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2] && err.empty(); ++k)
-      for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1] && err.empty(); ++j)
-        for (PetscInt i = ob.s[0]; i < ob.s[0] + ob.m[0]; ++i) {
-          for (size_t q = 0; q < vals.size(); ++q)
-            v[q] = vals[q]->at_cell(i, j, k);
-          if (tk.components)
-            std::copy(v, v + nc, s);
-          else
-            principal_to_components(dim, v, s);
-          if (surface) // the tensor is meant on the surface: correct it for the map's metric
-            surface->corrected_tensor(grid.centre(0, i), grid.centre(1, j), s, s);
-          const double d = D.at_cell(i, j, k);
-          const bool pd =
-              dim == 2 ? tensor_positive_definite<2>(s) : tensor_positive_definite<3>(s);
-          bool finite = std::isfinite(d);
-          for (int q = 0; q < nc; ++q)
-            finite = finite && std::isfinite(s[q]);
-          if (!pd || !finite || !(d >= 0)) {
-            std::ostringstream m;
-            m.precision(6);
-            m << (d >= 0 && std::isfinite(d) ? "-" + tk.keys[0] + ".." + tk.keys.back()
-                                             : "-" + dkey)
-              << ": the diffusion tensor of " << name << " must be positive definite with D_"
-              << name << " >= 0 at every cell; at cell " << cell_text(i, j, k, dim) << " D = " << d
-              << ", tensor (" << (tk.components ? "components" : "principal values") << ")";
-            for (size_t q = 0; q < vals.size(); ++q)
-              m << " " << tk.keys[q] << " = " << v[q];
-            err = m.str();
-            break;
-          }
-          const PetscInt gi = grid.local_index(i, j, k);
-          for (int q = 0; q < nc; ++q)
-            c[q][gi] = d * s[q];
-        }
-  } catch (const UserError& e) {
-    err = e.what();
-  }
-  throw_if_any(grid.comm(), err);
+  fill(0.0, c);
   out.op = std::make_unique<DiffusionOperator>(
       grid, halo,
       scheme == "first_order" ? DiffusionScheme::TensorFirstOrder : DiffusionScheme::Tensor,
       std::move(c));
   out.D_mean = mean_diagonal(*out.op, grid);
+  if (timed) {
+    out.components = nc;
+    out.timed = fill;
+  }
   return out;
 }
 

@@ -3,7 +3,10 @@
 //   -diffusion iso|tensor|polar|shaped, -diffusion_S ...  (all species / species S; default iso;
 //                       polar and shaped: app/state_diffusion_setup.hpp)
 //   -D_S VALUE          D_s: a number, or any value (expression, 'v +- a%', png(...)) for a
-//                       diffusion map; the tensor is multiplied by it
+//                       diffusion map; the tensor is multiplied by it. D_s and the tensor
+//                       values may use t (then an IsotropicField or tensor operator whose
+//                       coefficients are re-evaluated per step: operators/timed_diffusion.hpp;
+//                       not with polar|shaped)
 //   -tensor_scheme second_order|first_order
 //   tensor of species S, keys -tensor_S_NAME, else the shared -tensor_NAME:
 //     2-D  theta, l1, l2  (sigma = R(theta)^T diag(l1, l2) R(theta): l1 along (cos, sin) theta)
@@ -21,6 +24,7 @@
 #include "models/model.hpp"
 #include "operators/diffusion_operator.hpp"
 #include "operators/state_diffusion.hpp"
+#include "operators/timed_diffusion.hpp"
 
 #include <cstdint>
 #include <memory>
@@ -37,6 +41,10 @@ struct DiffusionSetup {
   // Solution-dependent coefficients (-diffusion_S polar|shaped: app/state_diffusion_setup.hpp),
   // else null.
   std::unique_ptr<CoefficientRule> rule;
+  // Coefficients using t (-D_S or a tensor value with t): fills the op's arrays at a time
+  // (operators/timed_diffusion.hpp), else null; components: their count.
+  TimedDiffusionTerm::Fill timed;
+  int components = 0;
   double D_mean = 0; // spatial mean of D_s (times the mean tensor's trace / dim)
 };
 

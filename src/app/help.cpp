@@ -22,7 +22,7 @@ const std::vector<std::pair<const char*, std::vector<const char*>>>& topics() {
       {"Grid", {"grid_", "stencil", "sequence_"}},
       {"Diffusion", {"diffusion", "tensor_", "surface_", "polar_", "shaped_"}},
       {"Time integration", {"integrator", "dt", "force_dt", "steps", "split_", "ts_"}},
-      {"Advection", {"advect", "velocity_"}},
+      {"Advection", {"advect", "velocity_", "fluid"}},
       {"Checkpoints and restart", {"checkpoint_", "restart", "max_walltime"}},
       {"Output",
        {"output_", "png_", "snapshot_", "summary", "progress_every", "nan_check_every", "movie_"}},
@@ -54,8 +54,9 @@ const Conditional kConditional[] = {
      "with -integrator ts: diffusion implicit (IMEX) or in the explicit right-hand side "
      "(default implicit)"},
     {"dirichlet_", "-dirichlet_<species> VALUE",
-     "boundary value on Dirichlet faces, an expression of the face position (default: the "
-     "species' initial value; with -grid_bc dirichlet)"},
+     "boundary value on Dirichlet faces, an expression of the face position that may use t "
+     "(re-evaluated once per step, or at the TS stage times) (default: the species' initial "
+     "value; with -grid_bc dirichlet)"},
     {"png_range_", "-png_range_<species> LO,HI",
      "fixed colour range of the species' images (default: from the data)"},
     {"diffusion_", "-diffusion_<species> iso|tensor|polar|shaped",
@@ -94,8 +95,16 @@ const Conditional kConditional[] = {
      "(default rk2; euler is the stable-ARD paper's eq. 20)"},
     {"advect", "-advection_halo W",
      "with -advect: halo width in cells (default 0: from max|u| dt/h at the start; at most 64)"},
+    {"fluid_", "-fluid_viscosity NU, -fluid_lid_speed U, -fluid_inflow U, -fluid_obstacle EXPR",
+     "with -fluid: viscosity (default 0.01), cavity lid speed and channel inflow (default 1), "
+     "solid cells where EXPR > 0.5 (default none)"},
+    {"fluid_", "-fluid_substeps N, -fluid_scheme linear|cubic",
+     "with -fluid: substeps per step (default 1), self-advection interpolation (default linear)"},
     {"sequence_steps", "-sequence_steps N1,...",
      "steps on each coarse level, coarsest first (with -sequence_levels L > 1: L-1 values)"},
+    {"", "-fluid_ksp_*, -fluid_pc_*, -fluid_visc_ksp_*, -fluid_visc_pc_*",
+     "PETSc KSP/PC options of the fluid's pressure solve (default cg/gamg) and viscosity "
+     "solves (default cg/jacobi)"},
     {"", "-diffusion_ksp_*, -diffusion_pc_*",
      "PETSc KSP/PC options of the diffusion solves (split and ts integrators; see -help petsc)"},
     {"", "-ts_*, -snes_*, -ksp_*, -pc_*",

@@ -3,10 +3,11 @@
 #include "core/collective_error.hpp"
 #include "core/log_events.hpp"
 #include "core/user_error.hpp"
-#include "io/slice_gather.hpp"
+#include "io/slice_image.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 namespace morphogen {
 
@@ -17,6 +18,12 @@ PngOutput::PngOutput(Options& opt, const Simulation& sim) {
   style_.colormap = *io::colormap_from_name(cmap);
   style_.scale = static_cast<int>(
       opt.integer("png_scale", 1, 1, 64, "PNG upscale factor: each cell becomes N x N pixels"));
+  max_size_ = opt.integer("png_max_size", 1024, 0, 1 << 24,
+                          "PNG images of slices larger than N cells along x or y show block means "
+                          "of f x f cells, f = ceil(max(nx,ny)/N); 0: full resolution");
+  if (max_size_ > 0 && max_size_ < 16)
+    throw UserError("-png_max_size " + std::to_string(max_size_) +
+                    ": allowed 0 (full resolution) or an image size of at least 16 pixels");
   style_.colorbar =
       opt.flag("png_colorbar", false, "add a colour bar with the lo, middle and hi values");
   style_.bits = std::stoi(opt.choice("png_bits", "8", {"8", "16"},
@@ -44,31 +51,72 @@ std::array<double, 2> PngOutput::range(const Simulation& sim, int s, double lo, 
   return r;
 }
 
+namespace {
+
+// Copies each file of `from` to the same name with `old_tag` replaced by `tag` (rank 0); an
+// error message or "".
+std::string copy_images(const std::vector<std::string>& from, const std::string& old_tag,
+                        const std::string& tag) {
+  for (const std::string& src : from) {
+    const size_t at = src.rfind("_" + old_tag + ".png");
+    const std::string dst = src.substr(0, at) + "_" + tag + ".png";
+    std::error_code ec;
+    std::filesystem::copy_file(src, dst + ".tmp", std::filesystem::copy_options::overwrite_existing,
+                               ec);
+    if (!ec) std::filesystem::rename(dst + ".tmp", dst, ec);
+    if (ec) {
+      std::filesystem::remove(dst + ".tmp", ec);
+      return "cannot write PNG file '" + dst + "': " + ec.message();
+    }
+  }
+  return "";
+}
+
+} // namespace
+
 void PngOutput::write(Simulation& sim, const std::string& tag) {
+  const double t0 = MPI_Wtime();
+  const Grid& g = sim.grid();
+  int rank = 0;
+  MPI_Comm_rank(g.comm(), &rank);
+  std::string err;
+  LogScope log_scope(log_events().output);
+  const long long step = static_cast<long long>(sim.step_index()) * 16 + sim.level();
+  if (step == last_step_ && !last_tag_.empty()) {
+    if (rank == 0) err = copy_images(last_paths_, last_tag_, tag);
+  } else {
+    err = draw(sim, tag);
+  }
+  throw_if_any(g.comm(), err);
+  last_step_ = step;
+  last_tag_ = tag;
+  seconds_ += MPI_Wtime() - t0;
+  files_ += static_cast<int>(sim.output().png_species.size());
+}
+
+std::string PngOutput::draw(Simulation& sim, const std::string& tag) {
   const Grid& g = sim.grid();
   const PetscInt k = g.dim() == 3 ? g.spec().n[2] / 2 : 0;
   int rank = 0;
   MPI_Comm_rank(g.comm(), &rank);
   std::string err;
-  LogScope log_scope(log_events().output);
+  last_paths_.clear();
   for (int s : sim.output().png_species) {
     const PetscScalar* a;
     MG_PETSC(VecGetArrayRead(sim.state()[s], &a));
-    std::vector<double> slice = io::gather_xy_slice(g, a, k);
+    const io::SliceImage img = io::gather_xy_slice_image(g, a, k, max_size_);
     MG_PETSC(VecRestoreArrayRead(sim.state()[s], &a));
     if (rank != 0 || !err.empty()) continue;
-    double lo = *std::min_element(slice.begin(), slice.end());
-    double hi = *std::max_element(slice.begin(), slice.end());
-    const auto r = range(sim, s, lo, hi);
+    const auto r = range(sim, s, img.lo, img.hi);
     const std::string path = sim.output().dir + "/" + sim.species()[s] + "_" + tag + ".png";
     try {
-      io::write_field_png(path, static_cast<int>(g.spec().n[0]), static_cast<int>(g.spec().n[1]),
-                          slice.data(), r[0], r[1], style_);
+      io::write_field_png(path, img.width, img.height, img.value.data(), r[0], r[1], style_);
+      last_paths_.push_back(path);
     } catch (const UserError& e) {
       err = std::string("-output_dir ") + sim.output().dir + ": " + e.what();
     }
   }
-  throw_if_any(g.comm(), err);
+  return err;
 }
 
 } // namespace morphogen

@@ -34,6 +34,7 @@ bool run_loop(Simulation& sim, PetscInt end_step, RunOutput& output, PngOutput& 
     }
   };
   if (sim.level() == 0) warn_if_reaction_stiff(sim);
+  if (sim.fluid()) PetscPrintf(comm, "%s\n", sim.fluid()->describe().c_str());
   if (sim.advection()) PetscPrintf(comm, "%s\n", sim.advection()->describe().c_str());
   for (PetscInt n = 1; n <= steps; ++n) {
     sim.step();
@@ -71,6 +72,7 @@ bool run_loop(Simulation& sim, PetscInt end_step, RunOutput& output, PngOutput& 
     std::snprintf(tag, sizeof tag, "%07lld", static_cast<long long>(sim.step_index()));
     write_images(tag);
     write_images("final");
+    output.note_images(pngs.seconds(), pngs.files());
     output.finish(sim);
   }
   return false;

@@ -259,10 +259,26 @@ bool RunOutput::after_step(Simulation& sim) {
   return true;
 }
 
+void RunOutput::print_output_times(double summary_seconds) const {
+  if (rank_ != 0) return;
+  std::printf("output: HDF5 snapshots %.3f s (%d file%s)\n", snapshot_seconds_, snapshots_,
+              snapshots_ == 1 ? "" : "s");
+  std::printf("output: PNG images %.3f s (%d file%s)\n", image_seconds_, image_files_,
+              image_files_ == 1 ? "" : "s");
+  if (summary_seconds >= 0) std::printf("output: summary.json %.3f s\n", summary_seconds);
+  std::printf("output: checkpoints %.3f s (%d file%s)\n", checkpoint_seconds_, checkpoints_,
+              checkpoints_ == 1 ? "" : "s");
+  std::fflush(stdout);
+}
+
 void RunOutput::finish(Simulation& sim) {
   write_snapshot(sim);
   if (sim.output().checkpoint_final) write_checkpoint(sim);
-  if (!sim.output().summary) return;
+  if (!sim.output().summary) {
+    print_output_times(-1);
+    return;
+  }
+  const double t0 = MPI_Wtime();
   nlohmann::json species = nlohmann::json::object();
   for (size_t s = 0; s < sim.species().size(); ++s) {
     nlohmann::json c =
@@ -271,7 +287,10 @@ void RunOutput::finish(Simulation& sim) {
     if (rank_ == 0) species[sim.species()[s]] = std::move(c);
   }
   nlohmann::json stability = stability_record(sim);
-  if (rank_ != 0) return;
+  if (rank_ != 0) {
+    print_output_times(0);
+    return;
+  }
   nlohmann::json j = {
       {"model", sim.model().name},
       {"step", static_cast<long long>(sim.step_index())},
@@ -288,7 +307,7 @@ void RunOutput::finish(Simulation& sim) {
   for (const auto& [name, c] : species.items())
     line += (line.empty() ? "" : ", ") + name + ": " + c["class"].get<std::string>();
   std::printf("pattern (summary.json): %s\n", line.c_str());
-  std::fflush(stdout);
+  print_output_times(MPI_Wtime() - t0);
 }
 
 void RunOutput::write_snapshot(Simulation& sim) {
@@ -296,6 +315,7 @@ void RunOutput::write_snapshot(Simulation& sim) {
   if (n == last_snapshot_step_) return;
   commit();
   LogScope log_scope(log_events().output);
+  const double t0 = MPI_Wtime();
   const auto& out = sim.output();
   const std::string file = step_file(out.name, n);
   const std::string path = out.dir + "/" + file;
@@ -326,6 +346,8 @@ void RunOutput::write_snapshot(Simulation& sim) {
     if (!index_err.empty()) write_failed("snapshot index", series_->series_path(), index_err);
   }
   last_snapshot_step_ = n;
+  snapshot_seconds_ += MPI_Wtime() - t0;
+  ++snapshots_;
 }
 
 void RunOutput::write_checkpoint(Simulation& sim) {
@@ -366,6 +388,8 @@ void RunOutput::write_checkpoint(Simulation& sim) {
   last_checkpoint_ = path;
   last_checkpoint_step_ = n;
   last_write_seconds_ = MPI_Wtime() - t0;
+  checkpoint_seconds_ += last_write_seconds_;
+  ++checkpoints_;
 }
 
 void RunOutput::write_failed(const std::string& what, const std::string& path,

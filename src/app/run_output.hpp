@@ -61,12 +61,20 @@ public:
   // and the linear stability of the parameters.
   void finish(Simulation& sim);
 
+  // The images' share of the output time (PngOutput::seconds, files), for the log lines that
+  // finish() prints: one per writer (snapshots, checkpoints, images, summary) with its time.
+  void note_images(double seconds, int files) {
+    image_seconds_ = seconds;
+    image_files_ = files;
+  }
+
   const std::string& last_checkpoint() const { return last_checkpoint_; }
   const std::string& stop_reason() const { return stop_reason_; }
 
 private:
   void write_snapshot(Simulation& sim);
   void write_checkpoint(Simulation& sim);
+  void print_output_times(double summary_seconds) const;
   [[noreturn]] void write_failed(const std::string& what, const std::string& path,
                                  const std::string& err) const;
   int poll_stop_flags(const Simulation& sim);
@@ -88,6 +96,8 @@ private:
   bool committed_ = false;      // commit() has run
   bool retire_pending_ = false; // checkpoints to retire at commit()
   long long retire_after_ = -1; // retire those with a step > this (-1: all)
+  double snapshot_seconds_ = 0, checkpoint_seconds_ = 0, image_seconds_ = 0; // per writer
+  int snapshots_ = 0, checkpoints_ = 0, image_files_ = 0;
   FieldSampler sampler_;
   PetscInt sample_every_ = 0;
 };

@@ -9,6 +9,7 @@
 #include "fields/field_fill.hpp"
 #include "grid/prolong.hpp"
 #include "operators/advection_setup.hpp"
+#include "operators/fluid_setup.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -28,7 +29,8 @@ Simulation::Simulation(MPI_Comm comm, Options& opt, const std::string& base_dir,
   read_grid(opt, level);
   read_model(opt, base_dir);
   read_time(opt);
-  advection_ = read_advection(opt, *grid_, species_, seed_, base_dir, dt_);
+  fluid_ = read_fluid(opt, *grid_, seed_, base_dir);
+  advection_ = read_advection(opt, *grid_, species_, seed_, base_dir, dt_, fluid_.get());
   read_output(opt);
   if (level.coarser) start_from(*level.coarser);
 }
@@ -110,17 +112,19 @@ void Simulation::read_grid(Options& opt, const SequenceLevel& level) {
       throw UserError("-grid_bc " + b + ": unknown boundary, allowed periodic, neumann, dirichlet");
   }
   const std::string def_stencil = spec_.dim == 2 ? "5pt" : "7pt";
-  const std::string st = opt.choice(
-      "stencil", def_stencil,
-      spec_.dim == 2 ? std::vector<std::string>{"5pt", "9pt"} : std::vector<std::string>{"7pt"},
-      "Laplacian stencil: 5pt or 9pt (isotropic, Garrity) in 2-D, 7pt in 3-D");
+  const std::string st =
+      opt.choice("stencil", def_stencil,
+                 spec_.dim == 2 ? std::vector<std::string>{"5pt", "9pt"}
+                                : std::vector<std::string>{"7pt", "19pt", "27pt"},
+                 "Laplacian stencil: 5pt or 9pt (isotropic, Garrity) in 2-D, 7pt, 19pt or 27pt "
+                 "(isotropic, Patra-Karttunen) in 3-D");
   const double h[3] = {spec_.h(0), spec_.h(1), spec_.h(2)};
   if (!make_stencil(st, spec_.dim, h, stencil_))
-    throw UserError("-stencil " + st +
-                    ": the isotropic 9pt stencil needs equal spacing hx = hy (got " +
-                    format_number(h[0]) + " and " + format_number(h[1]) + ")");
+    throw UserError("-stencil " + st + ": the isotropic " + st +
+                    " stencil needs equal spacings (got " + format_number(h[0]) + ", " +
+                    format_number(h[1]) + (spec_.dim == 3 ? ", " + format_number(h[2]) : "") + ")");
   spec_.stencil_width = 1;
-  spec_.box_stencil = stencil_.nterms == 9;
+  spec_.box_stencil = isotropic_box(stencil_);
   read_diffusion_kinds(opt, st);
   read_device_types(opt);
   grid_ = std::make_unique<Grid>(comm_, spec_);
@@ -135,11 +139,12 @@ void Simulation::read_diffusion_kinds(Options& opt, const std::string& stencil) 
     tensor_.push_back(read_tensor_choice(opt, model_->species[s].name));
     if (!tensor_.back()) continue;
     spec_.box_stencil = true; // cross terms read the ghost corners
-    if (stencil == "9pt")
-      throw UserError("-stencil 9pt: the isotropic 9-point stencil cannot be combined with "
-                      "-diffusion_" +
+    if (stencil == "9pt" || stencil == "19pt" || stencil == "27pt")
+      throw UserError("-stencil " + stencil + ": the isotropic " + stencil +
+                      " stencil cannot be combined with -diffusion_" +
                       std::string(model_->species[s].name) +
-                      " tensor (the tensor operator has its own box stencil); use -stencil 5pt");
+                      " tensor (the tensor operator has its own box stencil); use -stencil " +
+                      (spec_.dim == 2 ? "5pt" : "7pt"));
   }
   check_surface_needs_tensor(opt);
 }
@@ -215,20 +220,26 @@ void Simulation::read_model(Options& opt, const std::string& base_dir) {
   for (int d = 0; d < spec_.dim; ++d)
     any_dirichlet |= spec_.bc[d] == Boundary::Dirichlet;
   dirichlet_.assign(any_dirichlet ? ns : 0, FaceValues{});
+  boundary_ = std::make_unique<DirichletValues>(*grid_, *halo_, dirichlet_);
   u_.clear();
   ops_.clear();
   rules_.clear();
+  timed_coef_.clear();
+  timed_nc_.clear();
   for (int s = 0; s < ns; ++s) {
     const SpeciesInfo& si = model_->species[s];
     species_.emplace_back(si.name);
     DiffusionSetup ds =
         read_diffusion(opt, *grid_, *halo_, stencil_, si, tensor_[s], seed_, base_dir);
-    if (!ds.op->constant() && stencil_.nterms == 9)
-      throw UserError("-stencil 9pt: a diffusion map -D_" + std::string(si.name) +
-                      " needs -stencil 5pt (the map's operator has its own 5-point form)");
+    if (!ds.op->constant() && isotropic_box(stencil_))
+      throw UserError("-stencil " + stencil_.name + ": a diffusion map -D_" + std::string(si.name) +
+                      " (or a D using t) needs -stencil " + (spec_.dim == 2 ? "5pt" : "7pt") +
+                      " (the map's operator has its own star form)");
     D_[s] = ds.D_mean;
     ops_.push_back(std::move(ds.op));
     rules_.push_back(std::move(ds.rule));
+    timed_coef_.push_back(std::move(ds.timed));
+    timed_nc_.push_back(ds.components);
     const std::string ikey = std::string("init_") + si.name;
     ValueSpec init(ikey,
                    opt.string(ikey, format_double(si.init),
@@ -247,43 +258,12 @@ void Simulation::read_model(Options& opt, const std::string& base_dir) {
     MG_PETSC(VecRestoreArray(u_.back(), &a));
     if (any_dirichlet) {
       const std::string dkey = std::string("dirichlet_") + si.name;
-      ValueSpec g(dkey,
-                  opt.string(dkey, format_double(si.init),
-                             std::string("Dirichlet boundary value of ") + si.name +
-                                 " (expression of the face position)"),
-                  spec_, seed_, base_dir);
-      if (g.uses_time())
-        throw UserError("-" + dkey + " " + g.text() +
-                        ": time-dependent boundary values (t) are not supported yet");
-      const Box& gb = grid_->ghosted();
-      for (int d = 0; d < spec_.dim; ++d) {
-        if (spec_.bc[d] != Boundary::Dirichlet) continue;
-        for (int side = 0; side < 2; ++side) {
-          auto& face = dirichlet_[s].face[2 * d + side];
-          face.assign(static_cast<size_t>(halo_->face_size(d)), 0.0);
-          std::string err;
-          try {
-            for (PetscInt k = gb.s[2]; k < gb.s[2] + gb.m[2]; ++k)
-              for (PetscInt j = gb.s[1]; j < gb.s[1] + gb.m[1]; ++j)
-                for (PetscInt i = gb.s[0]; i < gb.s[0] + gb.m[0]; ++i) {
-                  PetscInt c[3] = {i, j, k};
-                  if (c[d] != gb.s[d]) continue;      // one entry per face position
-                  for (int e = 0; e < spec_.dim; ++e) // periodic images share face values
-                    if (spec_.bc[e] == Boundary::Periodic)
-                      c[e] = (c[e] % spec_.n[e] + spec_.n[e]) % spec_.n[e];
-                  double x[3] = {grid_->centre(0, c[0]), grid_->centre(1, c[1]),
-                                 spec_.dim == 3 ? grid_->centre(2, c[2]) : 0.0};
-                  x[d] = side == 0 ? 0.0 : spec_.L[d];
-                  c[d] = side == 0 ? 0 : spec_.n[d] - 1;
-                  face[halo_->face_index(d, i, j, k)] =
-                      g.at_point(x[0], x[1], x[2], c[0], c[1], c[2]);
-                }
-          } catch (const UserError& e) {
-            err = e.what();
-          }
-          throw_if_any(comm_, err);
-        }
-      }
+      boundary_->add(s, std::make_unique<ValueSpec>(
+                            dkey,
+                            opt.string(dkey, format_double(si.init),
+                                       std::string("Dirichlet boundary value of ") + si.name +
+                                           " (expression of the face position; may use t)"),
+                            spec_, seed_, base_dir));
     }
   }
   read_pins(opt, base_dir);
@@ -381,6 +361,7 @@ void Simulation::read_time(Options& opt) {
   if (!split_ && !(ts_ && ts_implicit_diffusion_)) {
     const bool force = opt.flag("force_dt", false,
                                 "run even when -dt exceeds the explicit diffusion stability bound");
+    force_dt_ = force;
     double lmax = 0;
     for (const auto& op : ops_)
       lmax = std::max(lmax, op->max_eigenvalue());
@@ -415,6 +396,9 @@ void Simulation::build_terms() {
       terms_.add(std::make_unique<StateDiffusionTerm>(static_cast<int>(s), species_[s], *ops_[s],
                                                       *halo_, std::move(rules_[s])),
                  true);
+    else if (timed_coef_[s]) // coefficients using t: set per step (operators/timed_diffusion.hpp)
+      terms_.add(std::make_unique<TimedDiffusionTerm>(static_cast<int>(s), species_[s], *ops_[s],
+                                                      *halo_, timed_nc_[s], timed_coef_[s]));
     else
       terms_.add(std::make_unique<DiffusionTerm>(static_cast<int>(s), species_[s], *ops_[s]));
   terms_.add(std::make_unique<ReactionTerm>(*grid_, model_->name, model_->rates, model_->nspecies,
@@ -425,6 +409,7 @@ void Simulation::build_terms() {
     clamp = clamp || std::isfinite(f);
   if (clamp) terms_.add(std::make_unique<ClampFloor>(*grid_, floor_));
   if (any_pins_) terms_.add(std::make_unique<PinnedCells>(pins_, species_));
+  terms_.use_boundary(boundary_.get());
   integrator_->use_terms(terms_);
 }
 
@@ -443,6 +428,7 @@ void Simulation::read_ts(Options& opt) {
   if (implicit) {
     matrices_ = std::make_unique<OperatorMatrices>(*grid_, *halo_, stencil_, operators(),
                                                    dirichlet_.empty() ? nullptr : &dirichlet_);
+    keep_timed_patterns();
     pin_matrices();
     terms_.use_matrices(matrices_.get()); // lagged solution-dependent operators re-assembled
   }
@@ -476,6 +462,7 @@ void Simulation::read_split(Options& opt) {
       opt.integer("split_newton_max_it", 20, 1, 1000, "Newton iteration cap per cell"));
   matrices_ = std::make_unique<OperatorMatrices>(*grid_, *halo_, stencil_, operators(),
                                                  dirichlet_.empty() ? nullptr : &dirichlet_);
+  keep_timed_patterns();
   pin_matrices();
   terms_.use_matrices(matrices_.get()); // lagged solution-dependent operators re-assembled
   diffusion_ = std::make_unique<DiffusionSolver>(*grid_, *matrices_, species_, opt);
@@ -485,6 +472,28 @@ void Simulation::read_split(Options& opt) {
       sources_.get(), *diffusion_, set);
   split_integrator_->use_constraints(terms_);
   stepper_ = split_integrator_.get();
+}
+
+// Species whose coefficients use t keep one matrix pattern over time (operator_matrices.hpp).
+void Simulation::keep_timed_patterns() {
+  for (size_t s = 0; s < timed_coef_.size(); ++s)
+    if (timed_coef_[s]) matrices_->keep_pattern(static_cast<int>(s));
+}
+
+// Explicit diffusion with coefficients using t: -dt must stay under the stability bound of the
+// coefficients at every step (checked after the step that used them).
+void Simulation::check_timed_stability() const {
+  if (force_dt_ || split_ || (ts_ && ts_implicit_diffusion_)) return;
+  bool timed = false;
+  for (const auto& f : timed_coef_)
+    timed = timed || static_cast<bool>(f);
+  if (!timed) return;
+  const double bound = terms_.stable_dt() / static_cast<double>(level_factor_ * level_factor_);
+  if (dt_ > bound)
+    throw UserError("-dt " + format_number(dt_) + ": at t = " + format_number(t_) +
+                    " the time-dependent diffusion needs dt <= " + format_number(bound) +
+                    " (explicit stability bound of the coefficients at that time); use a smaller "
+                    "-dt, -integrator split, or -force_dt");
 }
 
 void Simulation::read_output(Options& opt) {
@@ -571,8 +580,10 @@ void Simulation::step() {
   // (second order with Strang); the TS right-hand side evaluates them at its stage times.
   if (timed_->any() && !ts_) timed_->set_time(params_, split_ ? t_ + 0.5 * dt_ : t_);
   stepper_->step(u_, t_, dt_, step_ + 1);
+  check_timed_stability();
   // Advection after reaction and diffusion (stable-ARD section 5.2), then the constraints again
   // (pinned cells, the clamp floor under cubic overshoots).
+  if (fluid_) fluid_->step(dt_); // the velocity of [t, t + dt] (stable-ARD section 5)
   if (advection_) {
     advection_->apply(u_, t_, dt_);
     terms_.constrain(u_);

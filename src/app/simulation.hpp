@@ -5,6 +5,7 @@
 
 #include "app/model_registry.hpp"
 #include "core/options.hpp"
+#include "fields/dirichlet_values.hpp"
 #include "fields/param_set.hpp"
 #include "fields/source_terms.hpp"
 #include "fields/timed_params.hpp"
@@ -14,9 +15,11 @@
 #include "integrators/split_integrator.hpp"
 #include "integrators/ts_integrator.hpp"
 #include "operators/advection_stage.hpp"
+#include "operators/fluid_solver.hpp"
 #include "operators/pointwise_terms.hpp"
 #include "operators/state_diffusion.hpp"
 #include "operators/term_list.hpp"
+#include "operators/timed_diffusion.hpp"
 
 #include <memory>
 #include <string>
@@ -97,6 +100,8 @@ public:
   const SplitIntegrator* split_integrator() const { return split_integrator_.get(); }
   // The advection stage run after each step (-advect), or null.
   const AdvectionStage* advection() const { return advection_.get(); }
+  // The stable-fluids solver run before the advection stage each step (-fluid), or null.
+  FluidSolver* fluid() const { return fluid_.get(); }
   // Make ghosts current (after initialisation or before reading neighbours).
   void refresh_ghosts() { integrator_->update_ghosts(u_); }
   // Collective: throws UserError naming species, cell, step and time if any value is NaN/Inf.
@@ -117,6 +122,8 @@ private:
   void build_terms();
   void read_ts(Options& opt);
   void read_split(Options& opt);
+  void keep_timed_patterns();
+  void check_timed_stability() const;
 
   MPI_Comm comm_;
   std::string base_dir_;
@@ -130,12 +137,16 @@ private:
   ParamSet params_;
   std::unique_ptr<TimedParams> timed_; // parameters using t
   std::vector<FaceValues> dirichlet_;
+  std::unique_ptr<DirichletValues> boundary_; // fills dirichlet_ (re-evaluated when using t)
   std::vector<VecH> u_;
   std::vector<bool> tensor_;                         // per species: -diffusion_S tensor
   std::vector<std::vector<PinnedCells::Cell>> pins_; // per species: this rank's pinned cells
   bool any_pins_ = false;
   std::vector<std::unique_ptr<DiffusionOperator>> ops_;
   std::vector<std::unique_ptr<CoefficientRule>> rules_; // per species: polar/shaped, else null
+  std::vector<TimedDiffusionTerm::Fill> timed_coef_;    // per species: D using t, else null
+  std::vector<int> timed_nc_;                           // their component counts
+  bool force_dt_ = false;
   std::unique_ptr<OperatorMatrices> matrices_; // split and TS; before the integrators using it
   std::unique_ptr<SourceTerms> sources_;
   TermList terms_; // after the operators, parameters and sources its terms refer to
@@ -144,6 +155,7 @@ private:
   std::unique_ptr<SplitIntegrator> split_integrator_;
   std::unique_ptr<TsIntegrator> ts_integrator_;
   Integrator* stepper_ = nullptr;             // the integrator step() uses
+  std::unique_ptr<FluidSolver> fluid_;        // before the advection stage (-fluid)
   std::unique_ptr<AdvectionStage> advection_; // after every integrator's step (-advect)
   bool split_ = false, ts_ = false, ts_implicit_diffusion_ = true;
   PetscInt level_factor_ = 1; // coarsening factor of this sequencing level (1: finest)

@@ -9,17 +9,22 @@
 // integrator's per-cell reaction solve in ns per cell (target <= 10), a split step against an
 // explicit step on the same grid and ranks (target <= 10x) and the Brusselator deck to t = 125
 // explicit vs split (target >= 4x faster, same pattern). Runs on any number of ranks (aggregate
-// figures). Last line:
+// figures). Before all that (-bench_output_n, issue 13 parts 3-4, bench/bench_output.hpp): the
+// setup ns per cell, the PNG time and the peak memory per cell at 4096^2. Last line:
 //   roofline_fraction=<2-D fraction>
 #include "app/pattern_summary.hpp"
 #include "app/simulation.hpp"
+#include "bench/bench_fluids.hpp"
+#include "bench/bench_output.hpp"
 #include "bench/bench_scaling.hpp"
+#include "bench/bench_timing.hpp"
 #include "core/user_error.hpp"
 #include "integrators/reaction_lockstep_kernel.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <tuple>
 #include <vector>
 
@@ -80,16 +85,8 @@ Result bench_explicit(MPI_Comm comm, Options& opt, const std::string& n, int ste
   for (int i = 0; i < 5; ++i)
     sim.step(); // warm up
   Result r;
-  double best = 1e30;
-  for (int rep = 0; rep < 3; ++rep) {
-    MPI_Barrier(comm);
-    const double t0 = MPI_Wtime();
-    for (int i = 0; i < steps; ++i)
-      sim.step();
-    MPI_Barrier(comm);
-    best = std::min(best, MPI_Wtime() - t0);
-  }
-  r.cups = static_cast<double>(sim.grid().global_cells()) * steps / best;
+  r.cups =
+      static_cast<double>(sim.grid().global_cells()) / best_seconds_per_step(comm, sim, steps, 3);
   r.probe = {r.cups, sim.grid().spec().stencil_width, sim.grid().spec().box_stencil,
              static_cast<int>(sim.species().size())};
   // Halo-only update vs. PETSc's global-to-local copy, per species per step.
@@ -215,16 +212,7 @@ double seconds_per_step(MPI_Comm comm, Options& opt, const OptionPairs& o, int s
   Simulation sim(comm, opt, "");
   sim.step();
   sim.step();
-  double best = 1e30;
-  for (int rep = 0; rep < 3; ++rep) {
-    MPI_Barrier(comm);
-    const double t0 = MPI_Wtime();
-    for (int i = 0; i < steps; ++i)
-      sim.step();
-    MPI_Barrier(comm);
-    best = std::min(best, (MPI_Wtime() - t0) / steps);
-  }
-  return best;
+  return best_seconds_per_step(comm, sim, steps, 3);
 }
 
 // The per-cell reaction substep alone: nanoseconds per cell of the Strang half-step (dt 0.05,
@@ -240,10 +228,18 @@ void bench_reaction_kernel(MPI_Comm comm) {
   }
   const double p[3] = {3, 9, 1}, floor[2] = {-HUGE_VAL, -HUGE_VAL};
   double* out[2] = {oa.data(), ob.data()};
+  // Wall time and this thread's CPU time (the latter ignores time descheduled on a shared host).
+  auto cpu_now = [] {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+  };
+  double best_cpu = 1e30;
   auto time = [&](bool lockstep, int* its) {
     double best = 1e30;
+    best_cpu = 1e30;
     for (int rep = 0; rep < 5; ++rep) {
-      const double t0 = MPI_Wtime();
+      const double t0 = MPI_Wtime(), c0 = cpu_now();
       for (int r = 0; r < rows; ++r) {
         const double* in[2] = {a.data() + r * n, b.data() + r * n};
         CellSolve w{};
@@ -257,16 +253,18 @@ void bench_reaction_kernel(MPI_Comm comm) {
         *its = std::max(*its, w.iterations);
       }
       best = std::min(best, MPI_Wtime() - t0);
+      best_cpu = std::min(best_cpu, cpu_now() - c0);
     }
     return 1e9 * best / (n * rows);
   };
   int its_g = 0, its_l = 0;
   const double g = time(false, &its_g), l = time(true, &its_l);
+  const double l_cpu = 1e9 * best_cpu / (n * rows);
   PetscPrintf(comm,
               "split_reaction_kernel model=brusselator scheme=trapezoidal dt=0.05 cells=%d "
-              "per_cell_ns=%.1f lockstep_ns=%.1f speedup=%.1f newton_its_max=%d "
-              "target_lockstep_ns<=10 %s\n",
-              n * rows, g, l, g / l, its_l, l <= 10.0 ? "met" : "NOT met");
+              "per_cell_ns=%.1f lockstep_ns=%.1f lockstep_cpu_ns=%.1f speedup=%.1f "
+              "newton_its_max=%d target_lockstep_ns<=10 %s\n",
+              n * rows, g, l, l_cpu, g / l, its_l, l <= 10.0 ? "met" : "NOT met");
 }
 
 // A split step (auto: FFT where it applies, and KSP) against an explicit step on the same grid
@@ -363,6 +361,21 @@ int run(MPI_Comm comm) {
       "strong scaling on this node (1 rank vs all) and the weak-scaling model for clusters");
   const bool only_implicit =
       opt.flag("bench_only_implicit", false, "only the implicit-vs-explicit section");
+  const PetscInt output_n =
+      opt.integer("bench_output_n", 4096, 0, 65536,
+                  "grid side of the setup/PNG/peak-memory section, run first (0: skip)");
+  const bool with_fluids = opt.flag(
+      "bench_fluids", false,
+      "time the stable-fluids solver + implicit ARD at 128^2..1024^2 (stable-ARD Table 1)");
+  const PetscInt fluids_n =
+      opt.integer("bench_fluids_n", 1024, 128, 1024, "largest grid side of -bench_fluids");
+  const PetscInt fluids_steps =
+      opt.integer("bench_fluids_steps", 5, 1, 100000, "timed steps per case of -bench_fluids");
+  const bool only_fluids = opt.flag("bench_only_fluids", false, "only the fluids section");
+  if (with_fluids || only_fluids)
+    bench_fluids(comm, opt, static_cast<int>(fluids_n), static_cast<int>(fluids_steps));
+  if (only_fluids) return 0;
+  if (output_n > 0) bench_output(comm, opt, static_cast<int>(output_n));
   const double bw = stream_triad(comm, static_cast<size_t>(mb) * 1024 * 1024 / 8, 10);
   const double roof = bw / 32.0;
   PetscPrintf(comm, "ranks=%d\nstream_triad_GBps=%.2f\nroofline_cell_updates_per_s=%.4e\n", size,

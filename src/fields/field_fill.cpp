@@ -18,8 +18,10 @@ void fill_field(const Grid& grid, ValueSpec& spec, double* a, ArrayLayout layout
           if (!(v >= lo && v <= hi)) {
             err = "-" + spec.key() + " " + spec.text() + ": value " + format_double(v) +
                   " at cell (" + std::to_string(i) + "," + std::to_string(j) + "," +
-                  std::to_string(k) + ") is outside the allowed range [" + format_double(lo) +
-                  ", " + format_double(hi) + "]";
+                  std::to_string(k) + ")" +
+                  (spec.uses_time() ? " at t = " + format_number(t) : std::string()) +
+                  " is outside the allowed range [" + format_double(lo) + ", " + format_double(hi) +
+                  "]";
             break;
           }
           a[layout == ArrayLayout::Owned ? grid.owned_index(i, j, k) : grid.local_index(i, j, k)] =

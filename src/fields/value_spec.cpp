@@ -244,6 +244,9 @@ ValueSpec::ValueSpec(const std::string& key, const std::string& text, const Grid
     const bool cell_funcs = std::regex_search(expr, cellwise);
     uniform_ =
         (used.empty() || (used.size() == 1 && uses_t_)) && !cell_funcs && perturb_ == Perturb::None;
+    polar_ = used.count("r") > 0 || used.count("theta") > 0;
+    base_constant_ = used.empty() && !cell_funcs;
+    if (base_constant_) base_ = P.Eval(); // the same number Eval() gives at every cell
     if (used.empty() && !cell_funcs && perturb_ == Perturb::None) {
       constant_ = true;
       value_ = P.Eval();
@@ -290,7 +293,7 @@ std::string ValueSpec::where() const {
 double ValueSpec::eval_expr() {
   double v;
   try {
-    v = parser_->Eval();
+    v = base_constant_ ? base_ : parser_->Eval();
   } catch (const mu::Parser::exception_type& e) {
     throw UserError("-" + key_ + " " + text_ + ": " + e.GetMsg() + where());
   }
@@ -309,10 +312,14 @@ double ValueSpec::at_point(double x, double y, double z, PetscInt i, PetscInt j,
   if (constant_) return value_;
   x_ = x, y_ = y, z_ = z, t_ = t;
   i_ = static_cast<double>(i), j_ = static_cast<double>(j), k_ = static_cast<double>(k);
-  const double cx = x - 0.5 * grid_.L[0], cy = y - 0.5 * grid_.L[1];
-  r_ = std::sqrt(cx * cx + cy * cy);
-  theta_ = std::atan2(cy, cx);
-  const auto wrap = [&](PetscInt c, int d) { return ((c % grid_.n[d]) + grid_.n[d]) % grid_.n[d]; };
+  if (polar_) {
+    const double cx = x - 0.5 * grid_.L[0], cy = y - 0.5 * grid_.L[1];
+    r_ = std::sqrt(cx * cx + cy * cy);
+    theta_ = std::atan2(cy, cx);
+  }
+  const auto wrap = [&](PetscInt c, int d) {
+    return c >= 0 && c < grid_.n[d] ? c : ((c % grid_.n[d]) + grid_.n[d]) % grid_.n[d];
+  };
   cell_ = static_cast<std::uint64_t>(wrap(i, 0)) +
           static_cast<std::uint64_t>(grid_.n[0]) *
               (static_cast<std::uint64_t>(wrap(j, 1)) +

@@ -87,6 +87,10 @@ private:
   std::unique_ptr<mu::Parser> parser_;
   bool constant_ = false, uses_t_ = false, uniform_ = false;
   double value_ = 0.0;
+  // Setup speed: the expression without its perturbation is one number (evaluated once into
+  // base_, the cells add only their deviates), and r/theta are computed only when used.
+  bool base_constant_ = false, polar_ = true;
+  double base_ = 0.0;
   enum class Perturb { None, Uniform, Gauss } perturb_ = Perturb::None;
   double amount_ = 0.0;
   bool percent_ = false;

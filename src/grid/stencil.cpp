@@ -30,6 +30,19 @@ bool make_stencil(const std::string& name, int dim, const double* h, Stencil& s)
     r.add(1, -1, 0, s6);
     r.add(-1, 1, 0, s6);
     r.add(1, 1, 0, s6);
+  } else if ((name == "19pt" || name == "27pt") && dim == 3) {
+    if (std::abs(h[0] - h[1]) > 1e-12 * h[0] || std::abs(h[0] - h[2]) > 1e-12 * h[0]) return false;
+    // Weights of the centre, face, edge and corner neighbours (count of nonzero offsets).
+    const bool full = name == "27pt";
+    const double sc = 1.0 / ((full ? 30.0 : 6.0) * h[0] * h[0]);
+    const double w[4] = {full ? -128.0 : -24.0, full ? 14.0 : 2.0, full ? 3.0 : 1.0,
+                         full ? 1.0 : 0.0};
+    r.add(0, 0, 0, w[0] * sc);
+    for (int o = 0; o < 27; ++o) {
+      const int dx = o % 3 - 1, dy = (o / 3) % 3 - 1, dz = o / 9 - 1;
+      const int k = (dx != 0) + (dy != 0) + (dz != 0);
+      if (k > 0 && w[k] != 0.0) r.add(dx, dy, dz, w[k] * sc);
+    }
   } else {
     return false;
   }

@@ -6,6 +6,9 @@
 //       lap u = (4 (N+S+E+W) + (NE+NW+SE+SW) - 20 u) / (6 h^2)
 //     = (20 / (6 h^2)) (0.2 (N+S+E+W) + 0.05 (diagonals) - u); Garrity's unscaled operator
 //       with diffusion rate d equals this Laplacian with D = 0.3 d h^2.
+//   19pt (3-D, hx = hy = hz = h): (2 (6 faces) + (12 edges) - 24 u) / (6 h^2)
+//   27pt (3-D, equal h): (14 (6 faces) + 3 (12 edges) + (8 corners) - 128 u) / (30 h^2)
+//     (Patra & Karttunen 2006: isotropic leading error, lap + (h^2/12) lap^2 u for both)
 // All are second-order accurate and exact on quadratics. Term 0 is always the centre.
 // spectral_radius() is max |symbol| over the grid's Nyquist corners: the explicit Euler step
 // is stable for dt * D_max * spectral_radius <= 2.
@@ -54,7 +57,8 @@ struct Stencil {
 
 // The same stencil grouped by grid row, the form the explicit kernel consumes: row r has offset
 // (dy, dz) and x-taps w[r] = {weight at x-1, x, x+1}. Row 0 is the centre row. `box` is true
-// when a row other than the centre one has x-taps (9pt), false for star stencils (5pt, 7pt).
+// when a row other than the centre one has x-taps (9pt, 19pt, 27pt), false for star stencils
+// (5pt, 7pt).
 struct RowStencil {
   int nrows = 0;
   bool box = false;
@@ -62,11 +66,17 @@ struct RowStencil {
   std::array<double, 27> w{}; // w[3*r + (dx+1)]
 };
 
+// True for the isotropic box stencils (9pt, 19pt, 27pt): equal spacings, no tensor or map form.
+inline bool isotropic_box(const Stencil& s) {
+  return s.name == "9pt" || s.name == "19pt" || s.name == "27pt";
+}
+
 // Group a stencil with x offsets in [-1, 1] into rows; false if it has wider x offsets.
 bool to_rows(const Stencil& s, RowStencil& out);
 
-// Names accepted by make_stencil for the given dimension: "5pt" and "9pt" in 2-D, "7pt" in 3-D.
-// Returns false (stencil untouched) for an unknown name or a 9pt stencil with hx != hy.
+// Names accepted by make_stencil for the given dimension: "5pt" and "9pt" in 2-D, "7pt", "19pt"
+// and "27pt" in 3-D. Returns false (stencil untouched) for an unknown name or an isotropic box
+// stencil (9pt, 19pt, 27pt) with unequal spacings.
 bool make_stencil(const std::string& name, int dim, const double* h, Stencil& out);
 
 } // namespace morphogen

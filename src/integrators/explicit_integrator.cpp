@@ -116,6 +116,9 @@ void ExplicitIntegrator::step(std::vector<VecH>& u, double t, double dt, PetscIn
   if (work_.empty())
     for (int s = 0; s < ns_; ++s)
       work_.push_back(grid_.create_local());
+  // Coefficients and Dirichlet values using t: at the step's start (before the ghosts take the
+  // boundary values).
+  if (terms_) terms_->set_time(t);
   update_ghosts(u);
   if (terms_) terms_->refresh(u); // solution-dependent diffusion: coefficients of u^n
   if (others_.empty()) {

@@ -15,6 +15,8 @@
 // Other terms of the run (sources, ...: use_terms) are evaluated on u^n after the halo update,
 // and dt times their rates is added after the sweep, followed by the run's constraints:
 //   u^{n+1} = C( sweep(u^n) + dt sum_k T_k(u^n, t) )
+// Diffusion coefficients and Dirichlet values using t are set at the step's start t^n
+// (TermList::set_time) before the halo update, so the ghosts carry g(t^n).
 #pragma once
 
 #include "fields/param_set.hpp"

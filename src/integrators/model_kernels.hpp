@@ -20,9 +20,9 @@ namespace morphogen {
 using ExplicitRowFn = void (*)(const ExplicitRow&);
 
 // Row layouts of the fused sweep (RowStencil): 5pt (3 star rows), 7pt (5 star rows),
-// 9pt (3 box rows).
-enum class RowLayout { Star3 = 0, Star5 = 1, Box3 = 2 };
-constexpr int kRowLayouts = 3;
+// 9pt (3 box rows), 19pt and 27pt (9 box rows).
+enum class RowLayout { Star3 = 0, Star5 = 1, Box3 = 2, Box9 = 3 };
+constexpr int kRowLayouts = 4;
 
 // A model built at run time (models/runtime_model.hpp) has no fused kernels (fused = false:
 // the explicit integrator takes its general path) and generic pre/reaction rows that call its
@@ -36,7 +36,11 @@ struct ModelKernels {
   // The fused kernel of a row stencil; throws std::logic_error for a layout without one
   // (callers check the stencil first: there are no null entries to call).
   ExplicitRowFn row_kernel(bool field_params, int nrows, bool box) const {
-    const int idx = !box && nrows == 3 ? 0 : !box && nrows == 5 ? 1 : box && nrows == 3 ? 2 : -1;
+    const int idx = !box && nrows == 3   ? 0
+                    : !box && nrows == 5 ? 1
+                    : box && nrows == 3  ? 2
+                    : box && nrows == 9  ? 3
+                                         : -1;
     if (idx < 0 || !fused)
       throw std::logic_error("no fused explicit kernel for this stencil layout");
     return explicit_row[field_params ? 1 : 0][idx];
@@ -48,9 +52,11 @@ template <class M> ModelKernels model_kernels() {
   k.explicit_row[0][0] = &explicit_row<M, 3, false, false>;
   k.explicit_row[0][1] = &explicit_row<M, 5, false, false>;
   k.explicit_row[0][2] = &explicit_row<M, 3, true, false>;
+  k.explicit_row[0][3] = &explicit_row<M, 9, true, false>;
   k.explicit_row[1][0] = &explicit_row<M, 3, false, true>;
   k.explicit_row[1][1] = &explicit_row<M, 5, false, true>;
   k.explicit_row[1][2] = &explicit_row<M, 3, true, true>;
+  k.explicit_row[1][3] = &explicit_row<M, 9, true, true>;
   k.explicit_pre[0] = &explicit_row_pre<M, false>;
   k.explicit_pre[1] = &explicit_row_pre<M, true>;
   k.reaction_row[0] = &reaction_row_lockstep<M, false>; // 2-3 species: lockstep Newton

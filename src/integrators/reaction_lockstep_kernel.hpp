@@ -6,10 +6,15 @@
 //   Trapezoidal    F(v) = v - u - dt/2 (R(u) + S0 + R(v) + S1)       = 0
 // started from the better of u and the explicit Euler predictor, full Newton steps
 //   (I - c dt dR/du(v)) dv = -F(v),  v <- v + dv,
-// converged when ||dv||_inf <= tol (1 + max(||u||_inf, ||v||_inf)), but solved for W cells of
-// a row at once: every loop runs over the W lanes with branch-free selects (GCC vectorises it),
-// the linear solve is Cramer's rule on the analytic Jacobian (2x2, 3x3), and a converged lane
-// is frozen (it keeps the iterate at which it converged, as the per-cell solver returns it).
+// converged when ||dv||_inf <= tol (1 + max(||u||_inf, ||v||_inf)), but solved for W = 16 cells
+// of a row at once, held as structure-of-arrays (one array per species/state over the lanes):
+// the start and each Newton step is one loop over the lanes with no branches - 0/1 masks held
+// as doubles, selects, no early exit per lane - so GCC vectorises it (-fopt-info-vec reports
+// "loop vectorized" for lockstep_start and lockstep_newton; 512-bit vectors where the target
+// has AVX-512), the linear solve is Cramer's rule on the analytic Jacobian (2x2, 3x3), and a
+// converged lane is frozen by the masks (it keeps the iterate at which it converged, as the
+// per-cell solver returns it). Steps repeat until no lane of the chunk is active. A full chunk
+// in which every lane converged (the usual case) is loaded and stored by plain vector copies.
 // A lane that would need anything else - a damped step (the step is large and the full step
 // fails the per-cell solver's Armijo test), a (near-)singular Jacobian (|det| <= 64 eps
 // ||A||_inf^N), a non-finite value, or more than maxit iterations - is redone by
@@ -30,14 +35,29 @@ namespace morphogen {
 
 namespace detail {
 
+// The lane loops run on 512-bit vectors where the target has them (GCC; the rest of the build
+// prefers 256-bit ones).
+#if defined(__GNUC__) && !defined(__clang__) && defined(__AVX512F__)
+#define MG_LOCKSTEP_WIDE __attribute__((target("prefer-vector-width=512")))
+#else
+#define MG_LOCKSTEP_WIDE
+#endif
+
 inline bool finite_d(double x) {
   return std::fabs(x) <= DBL_MAX;
 } // false for NaN and inf
 
-// x = A^-1 b for N = 2, 3 (row-major A) by Cramer's rule; false when |det| <= 64 eps ||A||^N.
-template <int N> inline bool cramer_solve(const double* A, const double* b, double* x) {
+// 1.0 where x is finite, 0.0 for NaN and inf (a select, so that the lane loops vectorise).
+inline double finite_mask(double x) {
+  return std::fabs(x) <= DBL_MAX ? 1.0 : 0.0;
+}
+
+// x = A^-1 b for N = 2, 3 (row-major A) by Cramer's rule; returns 1.0, or 0.0 when
+// |det| <= 64 eps ||A||_inf^N (numerically singular; x is then unspecified). Branch-free.
+template <int N> inline double cramer_lane(const double* A, const double* b, double* x) {
   static_assert(N == 2 || N == 3, "cramer_solve: 2 or 3 unknowns");
   double norm = 0.0;
+#pragma GCC unroll 16
   for (int r = 0; r < N; ++r) {
     double row = 0.0;
 #pragma GCC unroll 16
@@ -50,7 +70,7 @@ template <int N> inline bool cramer_solve(const double* A, const double* b, doub
     const double inv = 1.0 / det;
     x[0] = (b[0] * A[3] - A[1] * b[1]) * inv;
     x[1] = (A[0] * b[1] - A[2] * b[0]) * inv;
-    return std::fabs(det) > 64.0 * DBL_EPSILON * norm * norm;
+    return std::fabs(det) > 64.0 * DBL_EPSILON * norm * norm ? 1.0 : 0.0;
   } else {
     const double c00 = A[4] * A[8] - A[5] * A[7], c01 = A[5] * A[6] - A[3] * A[8],
                  c02 = A[3] * A[7] - A[4] * A[6];
@@ -62,12 +82,16 @@ template <int N> inline bool cramer_solve(const double* A, const double* b, doub
            inv;
     x[2] = (c02 * b[0] + (A[1] * A[6] - A[0] * A[7]) * b[1] + (A[0] * A[4] - A[1] * A[3]) * b[2]) *
            inv;
-    return std::fabs(det) > 64.0 * DBL_EPSILON * norm * norm * norm;
+    return std::fabs(det) > 64.0 * DBL_EPSILON * norm * norm * norm ? 1.0 : 0.0;
   }
 }
 
-// The W lanes of one chunk: inputs, iterate and per-lane state (0/1 flags as doubles so that
-// every select vectorises).
+template <int N> inline bool cramer_solve(const double* A, const double* b, double* x) {
+  return cramer_lane<N>(A, b, x) != 0.0;
+}
+
+// The W lanes of one chunk (structure of arrays): inputs, iterate and per-lane state (0/1
+// flags as doubles so that every select vectorises).
 template <int NS, int NP, int W> struct LockstepLanes {
   double u[NS][W], s0[NS][W], s1[NS][W], p[NP][W];
   double base[NS][W], v[NS][W], F[NS][W], unorm[W], res[W], its[W], done[W], bad[W];
@@ -76,10 +100,10 @@ template <int NS, int NP, int W> struct LockstepLanes {
 // Start: base, the better of u and the Euler predictor, its residual; lanes with a non-finite
 // start are bad, lanes with a zero residual are done.
 template <class M, int NS, int NP, int W>
-inline void lockstep_start(LockstepLanes<NS, NP, W>& L, bool trap, double cdt) {
+MG_LOCKSTEP_WIDE inline void lockstep_start(LockstepLanes<NS, NP, W>& L, double trap, double cdt) {
 #pragma GCC ivdep
   for (int l = 0; l < W; ++l) {
-    double uc[NS], pc[NP], ru[NS], pred[NS], rp[NS];
+    double uc[NS], pc[NP], ru[NS], pred[NS], rp[NS], Fp[NS];
 #pragma GCC unroll 16
     for (int q = 0; q < NP; ++q)
       pc[q] = L.p[q][l];
@@ -87,17 +111,16 @@ inline void lockstep_start(LockstepLanes<NS, NP, W>& L, bool trap, double cdt) {
     for (int s = 0; s < NS; ++s)
       uc[s] = L.u[s][l];
     M::rates(uc, pc, ru);
-    double un = 0.0;
+    double un = 0.0, resp = 0.0, resu = 0.0, fin = 0.0, finu = 0.0; // sums: NaN/inf show there
 #pragma GCC unroll 16
     for (int s = 0; s < NS; ++s) {
-      L.base[s][l] = trap ? uc[s] + cdt * (ru[s] + L.s0[s][l]) : uc[s];
-      pred[s] = L.base[s][l] + cdt * (ru[s] + L.s1[s][l]);
+      const double b = uc[s] + trap * cdt * (ru[s] + L.s0[s][l]);
+      L.base[s][l] = b;
+      pred[s] = b + cdt * (ru[s] + L.s1[s][l]);
       const double a = std::fabs(uc[s]);
       un = a > un ? a : un;
     }
     M::rates(pred, pc, rp);
-    double resp = 0.0, resu = 0.0, fin = 0.0, finu = 0.0; // sums: NaN/inf show there
-    double Fp[NS];
 #pragma GCC unroll 16
     for (int s = 0; s < NS; ++s) {
       Fp[s] = pred[s] - L.base[s][l] - cdt * (rp[s] + L.s1[s][l]);
@@ -107,26 +130,27 @@ inline void lockstep_start(LockstepLanes<NS, NP, W>& L, bool trap, double cdt) {
       fin += Fp[s];
       finu += uc[s] + pred[s];
     }
-    const bool usep = finite_d(fin) & (resp < resu);
+    const double usep = finite_mask(fin) * (resp < resu ? 1.0 : 0.0);
 #pragma GCC unroll 16
     for (int s = 0; s < NS; ++s) {
-      L.v[s][l] = usep ? pred[s] : uc[s];
-      L.F[s][l] = usep ? Fp[s] : uc[s] - pred[s];
+      L.v[s][l] = usep != 0.0 ? pred[s] : uc[s];
+      L.F[s][l] = usep != 0.0 ? Fp[s] : uc[s] - pred[s];
     }
-    const double res = usep ? resp : resu;
+    const double res = usep != 0.0 ? resp : resu;
+    const double bad = 1.0 - finite_mask(finu);
     L.res[l] = res;
     L.unorm[l] = un;
     L.its[l] = 0.0;
-    L.bad[l] = finite_d(finu) ? 0.0 : 1.0;
-    L.done[l] = (L.bad[l] == 0.0) & (res == 0.0) ? 1.0 : 0.0;
+    L.bad[l] = bad;
+    L.done[l] = bad == 0.0 && res == 0.0 ? 1.0 : 0.0;
   }
 }
 
-// One full Newton step on every active lane; returns the number of lanes still active.
+// One full Newton step on every active lane (branch-free: every lane computes, selects keep
+// the finished ones).
 template <class M, int NS, int NP, int W>
-inline int lockstep_newton(LockstepLanes<NS, NP, W>& L, double cdt, double tol, double big,
-                           int it) {
-  int active = 0;
+MG_LOCKSTEP_WIDE inline void lockstep_newton(LockstepLanes<NS, NP, W>& L, double cdt, double tol,
+                                             double big, double it) {
 #pragma GCC ivdep
   for (int l = 0; l < W; ++l) {
     double vc[NS], pc[NP], J[NS * NS], rhs[NS], dv[NS], vt[NS], r[NS], Ft[NS];
@@ -147,7 +171,7 @@ inline int lockstep_newton(LockstepLanes<NS, NP, W>& L, double cdt, double tol, 
       rhs[s] = -L.F[s][l];
       f2 += L.F[s][l] * L.F[s][l];
     }
-    const bool regular = cramer_solve<NS>(J, rhs, dv);
+    const double regular = cramer_lane<NS>(J, rhs, dv);
 #pragma GCC unroll 16
     for (int s = 0; s < NS; ++s) {
       vt[s] = vc[s] + dv[s];
@@ -167,28 +191,85 @@ inline int lockstep_newton(LockstepLanes<NS, NP, W>& L, double cdt, double tol, 
       fin += Ft[s];
     }
     const double un = L.unorm[l];
-    // Bitwise & and | (no short-circuit branches), so that GCC if-converts and vectorises.
-    const bool far = step > big * (1.0 + (un > vcn ? un : vcn));
-    const bool armijo = ft2 <= (1.0 - 2e-4) * f2;
-    const bool act = (L.done[l] == 0.0) & (L.bad[l] == 0.0);
-    const bool fail = !regular | !finite_d(fin) | (far & !armijo);
-    const bool take = act & !fail;
-    // Every lane stores (selects of values read above, no conditional stores).
-    const double res0 = L.res[l], its0 = L.its[l], bad0 = L.bad[l], done0 = L.done[l];
+    const double far = step > big * (1.0 + (un > vcn ? un : vcn)) ? 1.0 : 0.0;
+    const double armijo = ft2 <= (1.0 - 2e-4) * f2 ? 1.0 : 0.0;
+    const double act = (1.0 - L.done[l]) * (1.0 - L.bad[l]);
+    const double ok = regular * finite_mask(fin) * (1.0 - far * (1.0 - armijo));
+    const double take = act * ok;
+    const double conv = step <= tol * (1.0 + (un > vtn ? un : vtn)) ? 1.0 : 0.0;
+    const double res0 = L.res[l], its0 = L.its[l];
 #pragma GCC unroll 16
     for (int s = 0; s < NS; ++s) {
       const double F0 = -rhs[s];
-      L.v[s][l] = take ? vt[s] : vc[s];
-      L.F[s][l] = take ? Ft[s] : F0;
+      L.v[s][l] = take != 0.0 ? vt[s] : vc[s];
+      L.F[s][l] = take != 0.0 ? Ft[s] : F0;
     }
-    L.res[l] = take ? rest : res0;
-    L.its[l] = take ? static_cast<double>(it) : its0;
-    L.bad[l] = act & fail ? 1.0 : bad0;
-    const bool conv = step <= tol * (1.0 + (un > vtn ? un : vtn));
-    L.done[l] = take & conv ? 1.0 : done0;
-    active += take & !conv ? 1 : 0;
+    L.res[l] = take != 0.0 ? rest : res0;
+    L.its[l] = take != 0.0 ? it : its0;
+    L.bad[l] += act * (1.0 - ok);
+    L.done[l] += take * conv;
   }
-  return active;
+}
+
+// Lanes still iterating (neither converged nor handed to the per-cell solver).
+template <int NS, int NP, int W>
+inline bool lockstep_any_active(const LockstepLanes<NS, NP, W>& L) {
+  double busy = 0.0;
+  for (int l = 0; l < W; ++l)
+    busy += (1.0 - L.done[l]) * (1.0 - L.bad[l]);
+  return busy != 0.0;
+}
+
+// Loads cells [i0, i0 + w) of the row into the lanes; lanes past the row repeat its last cell.
+// A full chunk (w = W) is plain vectorised copies.
+template <int NS, int NP, int W, bool FieldParams>
+inline void lockstep_load(LockstepLanes<NS, NP, W>& L, int i0, int w, int np,
+                          const double* const* u, const double* const* prow, const double* pconst,
+                          const double* const* S0, const double* const* S1) {
+  for (int s = 0; s < NS; ++s) {
+    const double *us = u[s] + i0, *a = S0 ? S0[s] + i0 : nullptr, *b = S1 ? S1[s] + i0 : nullptr;
+    if (w == W) {
+#pragma GCC ivdep
+      for (int l = 0; l < W; ++l)
+        L.u[s][l] = us[l];
+    } else
+      for (int l = 0; l < W; ++l)
+        L.u[s][l] = us[l < w ? l : w - 1];
+    for (int l = 0; l < W; ++l)
+      L.s0[s][l] = a ? a[l < w ? l : w - 1] : 0.0;
+    for (int l = 0; l < W; ++l)
+      L.s1[s][l] = b ? b[l < w ? l : w - 1] : 0.0;
+  }
+  for (int q = 0; q < np; ++q)
+    for (int l = 0; l < W; ++l)
+      L.p[q][l] = FieldParams ? prow[q][i0 + (l < w ? l : w - 1)] : pconst[q];
+}
+
+// 1.0 when every lane converged in the lockstep (no lane needs the per-cell solver).
+template <int NS, int NP, int W> inline bool lockstep_all_done(const LockstepLanes<NS, NP, W>& L) {
+  double d = 1.0;
+  for (int l = 0; l < W; ++l)
+    d *= L.done[l];
+  return d != 0.0;
+}
+
+// A full, converged chunk: clamped outputs, per-lane running maxima of iterations and residual.
+template <int NS, int NP, int W>
+inline void lockstep_store(const LockstepLanes<NS, NP, W>& L, int i0, const double* floor,
+                           double* const* out, double* its_max, double* res_max) {
+#pragma GCC unroll 16
+  for (int s = 0; s < NS; ++s) {
+    const double f = floor[s];
+    double* o = out[s] + i0;
+#pragma GCC ivdep
+    for (int l = 0; l < W; ++l)
+      o[l] = clamp_to_floor(L.v[s][l], f);
+  }
+#pragma GCC ivdep
+  for (int l = 0; l < W; ++l) {
+    its_max[l] = L.its[l] > its_max[l] ? L.its[l] : its_max[l];
+    res_max[l] = L.res[l] > res_max[l] ? L.res[l] : res_max[l];
+  }
 }
 
 } // namespace detail
@@ -201,7 +282,7 @@ inline int reaction_row_lockstep(ReactionScheme scheme, int n, const double* con
                                  CellSolve* worst) {
   constexpr int NS = M::nspecies;
   constexpr int NP = M::nparams > 0 ? M::nparams : 1;
-  constexpr int W = 8;
+  constexpr int W = 16;
   const bool implicit =
       scheme == ReactionScheme::BackwardEuler || scheme == ReactionScheme::Trapezoidal;
   if constexpr (NS != 2 && NS != 3)
@@ -215,24 +296,18 @@ inline int reaction_row_lockstep(ReactionScheme scheme, int n, const double* con
     const double cdt = trap ? 0.5 * dt : dt;
     const double big = std::sqrt(tol);
     CellSolve acc{0, 0.0, true};
+    double its_max[W] = {}, res_max[W] = {};
     detail::LockstepLanes<NS, NP, W> L;
     for (int i0 = 0; i0 < n; i0 += W) {
       const int w = n - i0 < W ? n - i0 : W;
-      for (int l = 0; l < W; ++l) { // lanes past the row repeat its last cell
-        const int i = i0 + (l < w ? l : w - 1);
-#pragma GCC unroll 16
-        for (int s = 0; s < NS; ++s) {
-          L.u[s][l] = u[s][i];
-          L.s0[s][l] = S0 ? S0[s][i] : 0.0;
-          L.s1[s][l] = S1 ? S1[s][i] : 0.0;
-        }
-#pragma GCC unroll 16
-        for (int q = 0; q < M::nparams; ++q)
-          L.p[q][l] = FieldParams ? prow[q][i] : pconst[q];
+      detail::lockstep_load<NS, NP, W, FieldParams>(L, i0, w, M::nparams, u, prow, pconst, S0, S1);
+      detail::lockstep_start<M>(L, trap ? 1.0 : 0.0, cdt);
+      for (int it = 1; it <= maxit && detail::lockstep_any_active(L); ++it)
+        detail::lockstep_newton<M>(L, cdt, tol, big, static_cast<double>(it));
+      if (w == W && detail::lockstep_all_done(L)) {
+        detail::lockstep_store(L, i0, floor, out, its_max, res_max);
+        continue;
       }
-      detail::lockstep_start<M>(L, trap, cdt);
-      for (int it = 1; it <= maxit; ++it)
-        if (detail::lockstep_newton<M>(L, cdt, tol, big, it) == 0) break;
       for (int l = 0; l < w; ++l) {
         double v[NS];
         CellSolve cs{static_cast<int>(L.its[l]), L.res[l], true};
@@ -262,6 +337,10 @@ inline int reaction_row_lockstep(ReactionScheme scheme, int n, const double* con
         for (int s = 0; s < NS; ++s)
           out[s][i0 + l] = clamp_to_floor(v[s], floor[s]);
       }
+    }
+    for (int l = 0; l < W; ++l) {
+      if (its_max[l] > acc.iterations) acc.iterations = static_cast<int>(its_max[l]);
+      if (res_max[l] > acc.residual) acc.residual = res_max[l];
     }
     if (worst) *worst = acc;
     return -1;

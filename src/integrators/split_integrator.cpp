@@ -126,9 +126,16 @@ std::vector<Substep> split_substeps(SplitOrdering ordering) {
 }
 
 void SplitIntegrator::step(std::vector<VecH>& u, double t, double dt, PetscInt step) {
-  if (terms_) // solution-dependent diffusion: coefficients of u^n, lagged over the step
+  if (terms_) { // solution-dependent diffusion: coefficients of u^n, lagged over the step
     for (int s : terms_->refresh(u))
       diffusion_.operator_changed(s);
+    // Coefficients and Dirichlet values using t: at the midpoint of the diffusion substep, which
+    // spans the whole step in both orderings (second order with Crank-Nicolson).
+    std::vector<int> changed;
+    terms_->set_time(t + 0.5 * dt, &changed);
+    for (int s : changed)
+      diffusion_.operator_changed(s);
+  }
   double t_reaction = t; // the reaction's (and sources') clock advances with its substeps
   for (const Substep& sub : substeps_) {
     if (sub.kind == Substep::Kind::Reaction) {

@@ -11,7 +11,9 @@
 // residual. D(dt) is the implicit diffusion substep (diffusion_solver.hpp: backward Euler or
 // Crank-Nicolson, theta = 1 or 1/2). Second order needs Strang with Crank-Nicolson and a
 // second-order reaction scheme (Heun or trapezoidal). The clamp floor is applied after the
-// reaction substeps and at the end of the step.
+// reaction substeps and at the end of the step. Diffusion coefficients and Dirichlet values
+// using t are set at the diffusion substep's midpoint t + dt/2 (TermList::set_time; the matrices
+// of the species whose coefficients changed are re-assembled, constant-in-time runs untouched).
 #pragma once
 
 #include "fields/param_set.hpp"

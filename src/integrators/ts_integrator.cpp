@@ -49,6 +49,7 @@ TsIntegrator::TsIntegrator(const Grid& grid, const Halo& halo,
   MG_PETSC(DMDACreateCompatibleDMDA(grid.dm(), ns_, dm_.out()));
   MG_PETSC(DMCreateGlobalVector(dm_, X_.out()));
   MG_PETSC(VecSet(X_, 0.0));
+  timed_ = terms_.any_time_dependent();
   try {
     if (ops_) build_operator();
     setup_ts(dt);
@@ -77,8 +78,6 @@ void TsIntegrator::build_operator() {
   const PetscInt rstart = ranges[rank], rend = ranges[rank + 1];
   if (rend - rstart != nloc_) throw std::logic_error("TsIntegrator: DMDA ownership mismatch");
   const PetscInt nb = ns_ * nloc_;
-  // Cell g of the scalar DMDA, species s -> row/column of the interlaced DMDA.
-  auto block_col = [&](PetscInt g, PetscInt s) { return ns_ * g + s; };
 
   std::vector<PetscInt> dnz(static_cast<size_t>(nb)), onz(static_cast<size_t>(nb));
   for (PetscInt s = 0; s < ns_; ++s) {
@@ -101,6 +100,22 @@ void TsIntegrator::build_operator() {
   MG_PETSC(MatSetType(Dblock_, MATAIJ));
   MG_PETSC(MatSeqAIJSetPreallocation(Dblock_, 0, dnz.data()));
   MG_PETSC(MatMPIAIJSetPreallocation(Dblock_, 0, dnz.data(), 0, onz.data()));
+  bD_.reset();
+  fill_operator();
+  MG_PETSC(MatDuplicate(Dblock_, MAT_COPY_VALUES, J_.out()));
+}
+
+// The values of K and of the interlaced Dirichlet data (Dblock_ preallocated or assembled with
+// the pattern of the M_s).
+void TsIntegrator::fill_operator() {
+  MPI_Comm comm = grid_.comm();
+  PetscInt rstart = 0, rend = 0;
+  {
+    VecH g = grid_.create_global();
+    MG_PETSC(VecGetOwnershipRange(g, &rstart, &rend));
+  }
+  // Cell g of the scalar DMDA, species s -> row/column of the interlaced DMDA.
+  auto block_col = [&](PetscInt g, PetscInt s) { return ns_ * g + s; };
   std::vector<PetscInt> bcols;
   std::vector<PetscScalar> bvals;
   for (PetscInt s = 0; s < ns_; ++s) {
@@ -125,10 +140,9 @@ void TsIntegrator::build_operator() {
   }
   MG_PETSC(MatAssemblyBegin(Dblock_, MAT_FINAL_ASSEMBLY));
   MG_PETSC(MatAssemblyEnd(Dblock_, MAT_FINAL_ASSEMBLY));
-  MG_PETSC(MatDuplicate(Dblock_, MAT_COPY_VALUES, J_.out()));
 
   // Interlaced Dirichlet data scale_s b_s.
-  MG_PETSC(VecDuplicate(X_, bD_.out()));
+  if (!bD_) MG_PETSC(VecDuplicate(X_, bD_.out()));
   PetscScalar* bd = nullptr;
   MG_PETSC(VecGetArray(bD_, &bd));
   int local_b = 0;
@@ -261,9 +275,17 @@ void TsIntegrator::setup_implicit_solver(double dt) {
 
 // ---- PETSc callbacks: no exception may leave them -------------------------------------------
 
-PetscErrorCode TsIntegrator::ifunction_cb(TS, PetscReal, Vec X, Vec Xdot, Vec F, void* ctx) {
+void TsIntegrator::at_time(double t) {
+  if (!timed_ || !terms_.set_time(t) || !ops_) return;
+  MG_PETSC(MatZeroEntries(Dblock_)); // (the pattern stays: OperatorMatrices::keep_pattern)
+  fill_operator();
+  jac_shift_ = -1; // J = shift I - K refilled on the next IJacobian
+}
+
+PetscErrorCode TsIntegrator::ifunction_cb(TS, PetscReal t, Vec X, Vec Xdot, Vec F, void* ctx) {
   auto* self = static_cast<TsIntegrator*>(ctx);
   try {
+    self->at_time(t);
     return self->ifunction(X, Xdot, F);
   } catch (...) {
     self->callback_error_ = std::current_exception();
@@ -274,6 +296,7 @@ PetscErrorCode TsIntegrator::ifunction_cb(TS, PetscReal, Vec X, Vec Xdot, Vec F,
 PetscErrorCode TsIntegrator::rhsfunction_cb(TS, PetscReal t, Vec X, Vec G, void* ctx) {
   auto* self = static_cast<TsIntegrator*>(ctx);
   try {
+    self->at_time(t);
     return self->rhsfunction(t, X, G);
   } catch (...) {
     self->callback_error_ = std::current_exception();
@@ -281,10 +304,11 @@ PetscErrorCode TsIntegrator::rhsfunction_cb(TS, PetscReal t, Vec X, Vec G, void*
   }
 }
 
-PetscErrorCode TsIntegrator::ijacobian_cb(TS, PetscReal, Vec, Vec, PetscReal shift, Mat A, Mat P,
+PetscErrorCode TsIntegrator::ijacobian_cb(TS, PetscReal t, Vec, Vec, PetscReal shift, Mat A, Mat P,
                                           void* ctx) {
   auto* self = static_cast<TsIntegrator*>(ctx);
   try {
+    self->at_time(t);
     return self->ijacobian(shift, A, P);
   } catch (...) {
     self->callback_error_ = std::current_exception();

@@ -41,6 +41,9 @@
 // Consecutive step() calls continue one TS integration (multistep schemes keep their history)
 // unless the state or the time changed in between (the clamp floor acted, or a restart): then
 // the step is restarted (TSRestartStep).
+// Diffusion coefficients and Dirichlet values using t are evaluated at the stage times: every
+// callback (right-hand side, IFunction, IJacobian) first sets the terms to its t
+// (TermList::set_time), and K and b are refreshed in place when they changed.
 // A diverged TS, SNES or KSP throws UserError from step() naming the step, time and PETSc's
 // reasons. Callbacks never let an exception into PETSc: they record it, return an error code,
 // and step() rethrows it after TSSolve returns.
@@ -92,6 +95,10 @@ private:
   PetscErrorCode fill_jacobian(PetscReal shift);
 
   void build_operator();
+  void fill_operator();
+  // Coefficients and Dirichlet values using t, at a stage time (from the callbacks): the
+  // implicit operator and its data follow in place (same nonzero pattern).
+  void at_time(double t);
   void setup_ts(double dt);
   void setup_implicit_solver(double dt);
   void check_type();
@@ -119,6 +126,7 @@ private:
   bool adaptive_ = false;
   double next_dt_ = 0; // the adaptive controller's proposal for the next internal step
   bool solved_ = false;
+  bool timed_ = false; // some coefficient or boundary value depends on t
 
   std::exception_ptr callback_error_;
   PetscInt steps_ = 0, rejected_ = 0;

@@ -10,12 +10,14 @@ std::vector<double> gather_xy_slice(const Grid& grid, const double* ghosted, Pet
   const Box& ob = grid.owned();
   const bool mine = k >= ob.s[2] && k < ob.s[2] + ob.m[2];
   int rect[4] = {0, 0, 0, 0};
-  std::vector<double> buf;
+  std::vector<double> buf; // this rank's rectangle (not on rank 0: it writes its own directly)
   if (mine) {
     rect[0] = static_cast<int>(ob.s[0]);
     rect[1] = static_cast<int>(ob.s[1]);
     rect[2] = static_cast<int>(ob.m[0]);
     rect[3] = static_cast<int>(ob.m[1]);
+  }
+  if (mine && rank != 0) {
     buf.reserve(static_cast<size_t>(ob.m[0] * ob.m[1]));
     for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j)
       for (PetscInt i = ob.s[0]; i < ob.s[0] + ob.m[0]; ++i)
@@ -25,7 +27,7 @@ std::vector<double> gather_xy_slice(const Grid& grid, const double* ghosted, Pet
   MPI_Gather(rect, 4, MPI_INT, rects.data(), 4, MPI_INT, 0, comm);
   std::vector<int> counts(size, 0), displs(size, 0);
   if (rank == 0)
-    for (int p = 0, off = 0; p < size; ++p) {
+    for (int p = 1, off = 0; p < size; ++p) { // rank 0 sends nothing
       counts[p] = rects[4 * p + 2] * rects[4 * p + 3];
       displs[p] = off;
       off += counts[p];
@@ -37,7 +39,11 @@ std::vector<double> gather_xy_slice(const Grid& grid, const double* ghosted, Pet
   if (rank != 0) return {};
   const PetscInt nx = grid.spec().n[0];
   std::vector<double> out(static_cast<size_t>(nx * grid.spec().n[1]), 0.0);
-  for (int p = 0; p < size; ++p) {
+  if (mine)
+    for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j)
+      for (PetscInt i = ob.s[0]; i < ob.s[0] + ob.m[0]; ++i)
+        out[i + nx * j] = ghosted[grid.local_index(i, j, k)];
+  for (int p = 1; p < size; ++p) {
     const int* r = &rects[4 * p];
     const double* src = all.data() + displs[p];
     for (int j = 0; j < r[3]; ++j)

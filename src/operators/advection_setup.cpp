@@ -41,7 +41,7 @@ void read_species(Options& opt, const std::string& text, const std::vector<std::
 std::unique_ptr<AdvectionStage> read_advection(Options& opt, const Grid& grid,
                                                const std::vector<std::string>& species,
                                                std::uint64_t seed, const std::string& base_dir,
-                                               double dt) {
+                                               double dt, const VelocitySource* fluid) {
   const auto text = opt.get("advect", "species carried by the velocity (comma-separated)");
   if (!text) {
     for (const char* k : kOptions)
@@ -67,6 +67,13 @@ std::unique_ptr<AdvectionStage> read_advection(Options& opt, const Grid& grid,
       opt.integer("advection_halo", 0, 0, AdvectionSettings::kMaxHalo,
                   "halo of the advected species in cells (0: from the largest Courant number "
                   "max|u| dt/h at the start, plus the interpolation stencil)"));
+  if (fluid) {
+    for (const char* k : {"velocity_x", "velocity_y", "velocity_z"})
+      if (opt.is_set(k))
+        throw UserError(std::string("-") + k + ": the velocity comes from " + fluid->option_text() +
+                        "; drop -" + k + " or the fluid");
+    return std::make_unique<AdvectionStage>(grid, *fluid, std::move(set), dt);
+  }
   auto velocity = std::make_unique<VelocityField>(grid, opt, seed, base_dir);
   return std::make_unique<AdvectionStage>(grid, std::move(velocity), std::move(set), dt);
 }

@@ -12,10 +12,12 @@
 
 namespace morphogen {
 
-// The run's advection stage, or null when -advect is not given. Collective.
+// The run's advection stage, or null when -advect is not given. With `fluid` (the run's
+// stable-fluids solver, -fluid) the velocity is the fluid's and -velocity_* are refused.
+// Collective.
 std::unique_ptr<AdvectionStage> read_advection(Options& opt, const Grid& grid,
                                                const std::vector<std::string>& species,
                                                std::uint64_t seed, const std::string& base_dir,
-                                               double dt);
+                                               double dt, const VelocitySource* fluid = nullptr);
 
 } // namespace morphogen

@@ -27,8 +27,24 @@ double courant_of(const Grid& grid, const std::array<double, 3>& umax, double dt
 AdvectionStage::AdvectionStage(const Grid& grid, std::unique_ptr<VelocityField> velocity,
                                AdvectionSettings settings, double dt)
     : grid_(grid), velocity_(std::move(velocity)), set_(std::move(settings)) {
+  setup(velocity_->max_abs(0.5 * dt), dt);
+  load_velocity(0.5 * dt);
+  checked_dt_ = dt;
+}
+
+AdvectionStage::AdvectionStage(const Grid& grid, const VelocitySource& source,
+                               AdvectionSettings settings, double dt)
+    : grid_(grid), source_(&source), set_(std::move(settings)) {
+  const double b = source.speed_bound();
+  setup({b, b, b}, dt);
+  load_velocity(0.0);
+}
+
+// The wide halo from the largest speed per axis umax (or -advection_halo), and the geometry.
+void AdvectionStage::setup(const std::array<double, 3>& umax, double dt) {
+  const Grid& grid = grid_;
   int axis = 0;
-  courant_ = courant_of(grid, velocity_->max_abs(0.5 * dt), dt, axis);
+  courant_ = courant_of(grid, umax, dt, axis);
   const long long need = advect::advection_reach(courant_, set_.interp);
   const std::string cn = "Courant number max|u_" + std::string(kAxis[axis]) + "| dt/h" +
                          kAxis[axis] + " = " + format_number(courant_);
@@ -53,14 +69,19 @@ AdvectionStage::AdvectionStage(const Grid& grid, std::unique_ptr<VelocityField> 
     geom_.m[d] = wide_->box().m[d];
   }
   w_.resize(static_cast<size_t>(wide_->size()));
-  load_velocity(0.5 * dt);
-  checked_dt_ = dt;
 }
 
 void AdvectionStage::load_velocity(double t) {
   for (int d = 0; d < grid_.dim(); ++d) {
     u_[d].resize(static_cast<size_t>(wide_->size()));
-    velocity_->evaluate(d, wide_->box(), t, u_[d].data());
+    if (source_) {
+      const PetscScalar* a;
+      MG_PETSC(VecGetArrayRead(source_->component(d), &a));
+      wide_->fill(a, u_[d].data());
+      MG_PETSC(VecRestoreArrayRead(source_->component(d), &a));
+    } else {
+      velocity_->evaluate(d, wide_->box(), t, u_[d].data());
+    }
   }
   for (int d = grid_.dim(); d < 3; ++d)
     u_[d].assign(static_cast<size_t>(wide_->size()), 0.0);
@@ -82,14 +103,17 @@ void AdvectionStage::check_reach(double dt, double t) {
   const long long need = advect::advection_reach(courant_, set_.interp);
   checked_dt_ = dt;
   if (need <= wide_->width()) return;
-  throw UserError(
-      "-velocity_" + std::string(kAxis[axis]) + " " + velocity_->text(axis) +
-      ": at t = " + format_number(t) + " the advection back-trace of -dt " + format_number(dt) +
-      " reaches " + std::to_string(need) + " cells (Courant number " + format_number(courant_) +
-      "), more than the advection halo (" + std::to_string(wide_->width()) + " cells, " +
-      (set_.halo > 0 ? "-advection_halo" : "sized from the velocity at the start") +
-      "); set -advection_halo " + std::to_string(need) + " (at most " +
-      std::to_string(AdvectionSettings::kMaxHalo) + ") or a smaller -dt");
+  const std::string what =
+      source_ ? source_->option_text() + ": the fluid velocity"
+              : "-velocity_" + std::string(kAxis[axis]) + " " + velocity_->text(axis);
+  throw UserError(what + ": at t = " + format_number(t) + " the advection back-trace of -dt " +
+                  format_number(dt) + " reaches " + std::to_string(need) +
+                  " cells (Courant number " + format_number(courant_) +
+                  "), more than the advection halo (" + std::to_string(wide_->width()) +
+                  " cells, " +
+                  (set_.halo > 0 ? "-advection_halo" : "sized from the velocity at the start") +
+                  "); set -advection_halo " + std::to_string(need) + " (at most " +
+                  std::to_string(AdvectionSettings::kMaxHalo) + ") or a smaller -dt");
 }
 
 void AdvectionStage::compute_departures(double dt) {
@@ -123,7 +147,10 @@ void AdvectionStage::transport(Vec v) {
 }
 
 void AdvectionStage::apply(std::vector<VecH>& u, double t, double dt) {
-  if (velocity_->uses_time()) {
+  if (source_) {
+    load_velocity(t + dt);
+    check_reach(dt, t + dt);
+  } else if (velocity_->uses_time()) {
     load_velocity(t + 0.5 * dt);
     check_reach(dt, t + 0.5 * dt);
   } else if (dt != checked_dt_) {
@@ -148,8 +175,9 @@ std::string AdvectionStage::describe() const {
   for (const auto& n : set_.names)
     names += (names.empty() ? "" : ",") + n;
   std::string vel;
-  for (int d = 0; d < grid_.dim(); ++d)
+  for (int d = 0; d < grid_.dim() && !source_; ++d)
     vel += (d ? ", " : "") + std::string("u_") + kAxis[d] + " = " + velocity_->text(d);
+  if (source_) vel = "velocity of " + source_->option_text();
   return "advection of " + names + " (semi-Lagrangian, " +
          (set_.interp == advect::Interp::Cubic ? "cubic" : "linear") + ", " +
          (set_.backtrace == advect::Backtrace::Rk2 ? "rk2" : "euler") + " back-trace; " + vel +

@@ -13,12 +13,15 @@
 //
 // The velocity is evaluated on the wide box once (steady) or once per step at the step's
 // midpoint t + dt/2 (velocity using t); departure points of a steady velocity are computed once
-// per dt and reused.
+// per dt and reused. A velocity computed by the run (VelocitySource: the stable-fluids solver)
+// is instead spread from its owned cells through the same wide halo at every step (its state
+// at the end of the fluid's step), its reach checked and its departure points recomputed.
 #pragma once
 
 #include "fields/velocity_field.hpp"
 #include "grid/wide_halo.hpp"
 #include "operators/advection_kernel.hpp"
+#include "operators/velocity_source.hpp"
 
 #include <memory>
 #include <string>
@@ -40,6 +43,9 @@ public:
   // Collective; throws UserError when dt's back-trace does not fit the halo.
   AdvectionStage(const Grid& grid, std::unique_ptr<VelocityField> velocity,
                  AdvectionSettings settings, double dt);
+  // The velocity of `source` (which outlives the stage), read at every apply(). Collective.
+  AdvectionStage(const Grid& grid, const VelocitySource& source, AdvectionSettings settings,
+                 double dt);
 
   const AdvectionSettings& settings() const { return set_; }
   int halo() const { return wide_->width(); }
@@ -54,13 +60,15 @@ public:
   std::string describe() const;
 
 private:
+  void setup(const std::array<double, 3>& umax, double dt);
   void load_velocity(double t);
   void check_reach(double dt, double t);
   void compute_departures(double dt);
   void transport(Vec v);
 
   const Grid& grid_;
-  std::unique_ptr<VelocityField> velocity_;
+  std::unique_ptr<VelocityField> velocity_; // expressions (null with a source)
+  const VelocitySource* source_ = nullptr;  // a velocity computed by the run
   AdvectionSettings set_;
   std::unique_ptr<WideHalo> wide_;
   advect::WideGeom geom_;

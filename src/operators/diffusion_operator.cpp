@@ -161,7 +161,7 @@ void DiffusionOperator::zero_flux_dual(PetscInt i, PetscInt j, PetscInt k, Petsc
 }
 
 bool DiffusionOperator::box() const {
-  if (scheme_ == DiffusionScheme::Constant) return stencil_.nterms == 9;
+  if (scheme_ == DiffusionScheme::Constant) return isotropic_box(stencil_);
   return scheme_ != DiffusionScheme::IsotropicField;
 }
 
@@ -248,8 +248,14 @@ void DiffusionOperator::apply_row(const double* u, PetscInt c, int n, double* ou
     case 7:
       constant_row<7>(stencil_.w.data(), delta_.data(), D_, u + c, n, out);
       break;
-    default:
+    case 9:
       constant_row<9>(stencil_.w.data(), delta_.data(), D_, u + c, n, out);
+      break;
+    case 19:
+      constant_row<19>(stencil_.w.data(), delta_.data(), D_, u + c, n, out);
+      break;
+    default:
+      constant_row<27>(stencil_.w.data(), delta_.data(), D_, u + c, n, out);
     }
     return;
   }

@@ -18,33 +18,42 @@ struct Term {
 } // namespace
 
 LaplacianMatrix::LaplacianMatrix(const Grid& grid, const Halo& halo, const Stencil& stencil,
-                                 int nspecies, const std::vector<FaceValues>* dirichlet) {
-  assemble(
-      grid, halo,
-      [&](PetscInt, PetscInt, PetscInt, std::vector<CellTerm>& out) {
+                                 int nspecies, const std::vector<FaceValues>* dirichlet)
+    : grid_(grid), halo_(halo),
+      terms_([stencil](PetscInt, PetscInt, PetscInt, std::vector<CellTerm>& out) {
         for (int t = 0; t < stencil.nterms; ++t)
           out.push_back({{stencil.off[t][0], stencil.off[t][1], stencil.off[t][2]}, stencil.w[t]});
-      },
-      nspecies, dirichlet);
+      }),
+      nspecies_(nspecies) {
+  assemble(dirichlet, true);
 }
 
 LaplacianMatrix::LaplacianMatrix(const Grid& grid, const Halo& halo, const CellTermsFn& terms,
-                                 int nspecies, const std::vector<FaceValues>* dirichlet) {
-  assemble(grid, halo, terms, nspecies, dirichlet);
+                                 int nspecies, const std::vector<FaceValues>* dirichlet)
+    : grid_(grid), halo_(halo), terms_(terms), nspecies_(nspecies) {
+  assemble(dirichlet, true);
 }
 
-void LaplacianMatrix::assemble(const Grid& grid, const Halo& halo, const CellTermsFn& cell_terms,
-                               int nspecies, const std::vector<FaceValues>* dirichlet) {
+void LaplacianMatrix::set_dirichlet(const std::vector<FaceValues>& dirichlet) {
+  assemble(&dirichlet, false);
+}
+
+void LaplacianMatrix::assemble(const std::vector<FaceValues>* dirichlet, bool matrix) {
+  const Grid& grid = grid_;
+  const Halo& halo = halo_;
+  const CellTermsFn& cell_terms = terms_;
   const GridSpec& g = grid.spec();
-  DM dm = grid.dm();
-  MG_PETSC(DMSetMatType(dm, MATAIJ));
-  MG_PETSC(DMCreateMatrix(dm, L_.out()));
-  // Preallocated for the DMDA's stencil (box when any operator has cross terms): a term
-  // outside it is a bug, reported instead of silently reallocating.
-  MG_PETSC(MatSetOption(L_, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
-  const size_t ns = static_cast<size_t>(nspecies);
-  for (size_t s = 0; s < ns; ++s)
-    b_.push_back(grid.create_global());
+  const size_t ns = static_cast<size_t>(nspecies_);
+  if (matrix) {
+    DM dm = grid.dm();
+    MG_PETSC(DMSetMatType(dm, MATAIJ));
+    MG_PETSC(DMCreateMatrix(dm, L_.out()));
+    // Preallocated for the DMDA's stencil (box when any operator has cross terms): a term
+    // outside it is a bug, reported instead of silently reallocating.
+    MG_PETSC(MatSetOption(L_, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
+    for (size_t s = 0; s < ns; ++s)
+      b_.push_back(grid.create_global());
+  }
   std::vector<PetscScalar*> barr(ns);
   for (size_t s = 0; s < ns; ++s)
     MG_PETSC(VecGetArray(b_[s], &barr[s]));
@@ -90,6 +99,9 @@ void LaplacianMatrix::assemble(const Grid& grid, const Halo& halo, const CellTer
         cell_terms(i, j, k, cterms);
         for (const CellTerm& ct : cterms)
           resolve(resolve, i + ct.off[0], j + ct.off[1], k + ct.off[2], ct.w);
+        for (size_t s = 0; s < ns; ++s)
+          barr[s][grid.owned_index(i, j, k)] = consts[s];
+        if (!matrix) continue;
         MatStencil row{};
         row.i = i, row.j = j, row.k = k;
         cols.clear();
@@ -102,11 +114,11 @@ void LaplacianMatrix::assemble(const Grid& grid, const Halo& halo, const CellTer
         }
         MG_PETSC(MatSetValuesStencil(L_, 1, &row, static_cast<PetscInt>(cols.size()), cols.data(),
                                      vals.data(), ADD_VALUES));
-        for (size_t s = 0; s < ns; ++s)
-          barr[s][grid.owned_index(i, j, k)] = consts[s];
       }
-  MG_PETSC(MatAssemblyBegin(L_, MAT_FINAL_ASSEMBLY));
-  MG_PETSC(MatAssemblyEnd(L_, MAT_FINAL_ASSEMBLY));
+  if (matrix) {
+    MG_PETSC(MatAssemblyBegin(L_, MAT_FINAL_ASSEMBLY));
+    MG_PETSC(MatAssemblyEnd(L_, MAT_FINAL_ASSEMBLY));
+  }
   for (size_t s = 0; s < ns; ++s)
     MG_PETSC(VecRestoreArray(b_[s], &barr[s]));
 }

@@ -38,11 +38,18 @@ public:
 
   Mat L() const { return L_.get(); }
   Vec b(int species) const { return b_[species]; }
+  // New Dirichlet values (one set per species, as at construction): b is recomputed in place
+  // (the same Vecs), L is kept. Collective.
+  void set_dirichlet(const std::vector<FaceValues>& dirichlet);
 
 private:
-  void assemble(const Grid& grid, const Halo& halo, const CellTermsFn& terms, int nspecies,
-                const std::vector<FaceValues>* dirichlet);
+  // matrix false: only b (L exists already).
+  void assemble(const std::vector<FaceValues>* dirichlet, bool matrix);
 
+  const Grid& grid_;
+  const Halo& halo_;
+  CellTermsFn terms_;
+  int nspecies_;
   MatH L_;
   std::vector<VecH> b_;
 };

@@ -1,5 +1,7 @@
 #include "operators/operator_matrices.hpp"
 
+#include <cmath>
+
 namespace morphogen {
 
 OperatorMatrices::OperatorMatrices(const Grid& grid, const Halo& halo, const Stencil& stencil,
@@ -25,6 +27,7 @@ OperatorMatrices::OperatorMatrices(const Grid& grid, const Halo& halo, const Ste
     index_.push_back(0);
     scale_.push_back(1.0);
   }
+  keep_pattern_.assign(static_cast<size_t>(ns), false);
   pinned_M_.resize(static_cast<size_t>(ns));
   pinned_b_.resize(static_cast<size_t>(ns));
   pin_rows_.resize(static_cast<size_t>(ns));
@@ -36,12 +39,17 @@ std::shared_ptr<LaplacianMatrix> OperatorMatrices::own_matrix(int s) const {
   const int nb = grid_.dim() == 2 ? 9 : 27;
   std::vector<FaceValues> own;
   if (has_dirichlet_ && !dirichlet_.empty()) own.push_back(dirichlet_[s]);
-  auto terms = [&op, nb](PetscInt i, PetscInt j, PetscInt k,
-                         std::vector<LaplacianMatrix::CellTerm>& out) {
+  // With keep: the star (isotropic maps) or the whole box (tensors), zeros included.
+  const bool keep = keep_pattern_.size() > static_cast<size_t>(s) && keep_pattern_[s];
+  const bool box = op.box();
+  auto terms = [&op, nb, keep, box](PetscInt i, PetscInt j, PetscInt k,
+                                    std::vector<LaplacianMatrix::CellTerm>& out) {
     double w[27];
     op.weights(i, j, k, w);
     for (int t = 0; t < nb; ++t)
-      if (w[t] != 0.0)
+      if (w[t] != 0.0 || (keep && (box || std::abs(t % 3 - 1) + std::abs((t / 3) % 3 - 1) +
+                                                  (nb == 27 ? std::abs(t / 9 - 1) : 0) <=
+                                              1)))
         out.push_back({{t % 3 - 1, (t / 3) % 3 - 1, nb == 27 ? t / 9 - 1 : 0}, w[t]});
   };
   return std::make_shared<LaplacianMatrix>(grid_, halo_, terms, 1, own.empty() ? nullptr : &own);
@@ -57,6 +65,37 @@ void OperatorMatrices::reassemble(int s) {
     const auto values = pin_values_[s];
     pin(s, rows, values);
   }
+}
+
+void OperatorMatrices::keep_pattern(int s) {
+  if (ops_[s]->constant() || keep_pattern_[s]) return;
+  keep_pattern_[s] = true;
+  reassemble(s);
+}
+
+std::vector<int> OperatorMatrices::set_dirichlet(const std::vector<FaceValues>& dirichlet) {
+  std::vector<int> renewed;
+  if (!has_dirichlet_ || dirichlet_.empty()) return renewed;
+  dirichlet_ = dirichlet;
+  const LaplacianMatrix* shared_done = nullptr;
+  for (int s = 0; s < nspecies(); ++s) {
+    if (ops_[s]->constant()) {
+      if (mat_[s].get() != shared_done) mat_[s]->set_dirichlet(dirichlet_);
+      shared_done = mat_[s].get();
+    } else {
+      mat_[s]->set_dirichlet({dirichlet_[s]});
+    }
+  }
+  for (int s = 0; s < nspecies(); ++s)
+    if (pinned_M_[s]) { // the coupling to the held values is redone on the new b_s
+      pinned_M_[s].reset();
+      pinned_b_[s].reset();
+      const auto rows = pin_rows_[s];
+      const auto values = pin_values_[s];
+      pin(s, rows, values);
+      renewed.push_back(s);
+    }
+  return renewed;
 }
 
 void OperatorMatrices::pin(int s, const std::vector<PetscInt>& rows,

@@ -35,6 +35,14 @@ public:
   // Re-assemble species s's own matrix from its operator (whose coefficients changed:
   // solution-dependent diffusion, lagged), pinned cells held again. Collective.
   void reassemble(int s);
+  // Species s's coefficients will change in time (TimedDiffusionTerm): its matrix keeps every
+  // entry of its scheme's stencil, zeros included, so that re-assembled matrices share one
+  // nonzero pattern (the TS integrator copies values into its operator in place). Collective.
+  void keep_pattern(int s);
+  // New Dirichlet values (one set per species; time-dependent boundary data): the vectors b_s
+  // are recomputed, the matrices kept. Returns the species whose M(s) is a new matrix (pinned
+  // cells, whose coupling is redone). Collective.
+  std::vector<int> set_dirichlet(const std::vector<FaceValues>& dirichlet);
   double scale(int s) const { return scale_[s]; }
   // False where the operator is not symmetric (first-order tensor masks): CG does not apply.
   bool symmetric(int s) const { return symmetric_[s]; }
@@ -54,7 +62,8 @@ private:
   std::vector<int> index_; // which of the matrix's b vectors is species s's
   std::vector<double> scale_;
   std::vector<bool> symmetric_;
-  std::vector<MatH> pinned_M_; // per species: own matrix when pinned (else null)
+  std::vector<bool> keep_pattern_; // per species: zeros of the stencil kept
+  std::vector<MatH> pinned_M_;     // per species: own matrix when pinned (else null)
   std::vector<VecH> pinned_b_;
   bool has_dirichlet_ = false;
 };

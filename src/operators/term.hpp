@@ -61,6 +61,12 @@ public:
   // each step (lagged). Returns true when the term changed (its matrix must be re-assembled).
   // Collective.
   virtual bool refresh(const std::vector<VecH>& /*u*/) const { return false; }
+  // True when the term's coefficients depend on t (a diffusion coefficient or tensor using t).
+  virtual bool timed_coefficients() const { return false; }
+  // Time-dependent coefficients: evaluate them at t (the explicit integrator at the step's
+  // start, the split integrator at the diffusion substep's midpoint, TS at its stage times).
+  // Returns true when they changed (the matrix must be re-assembled). Collective.
+  virtual bool set_time(double /*t*/) const { return false; }
   // rates += T(state, t) on this rank's owned cells (state ghosts current when halo().width > 0).
   virtual void add_rates(const StateArrays& state, double t, const RateArrays& rates) const = 0;
 };

@@ -44,6 +44,27 @@ std::vector<int> TermList::refresh(const std::vector<VecH>& u) const {
   return changed;
 }
 
+bool TermList::set_time(double t, std::vector<int>* changed) const {
+  bool any = false;
+  if (timed_)
+    for (const auto& t_ : terms_)
+      if (t_->timed_coefficients() && t_->set_time(t)) {
+        any = true;
+        if (const auto* d = dynamic_cast<const DiffusionTerm*>(t_.get())) {
+          if (changed) changed->push_back(d->species());
+          if (matrices_) matrices_->reassemble(d->species());
+        }
+      }
+  if (boundary_ && boundary_->set_time(t)) {
+    any = true;
+    if (matrices_)
+      for (int s : matrices_->set_dirichlet(boundary_->values()))
+        if (changed && std::find(changed->begin(), changed->end(), s) == changed->end())
+          changed->push_back(s);
+  }
+  return any;
+}
+
 double TermList::stable_dt() const {
   double dt = std::numeric_limits<double>::infinity();
   for (const auto& t : terms_)

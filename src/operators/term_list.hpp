@@ -7,6 +7,8 @@
 #include "operators/diffusion_term.hpp"
 #include "operators/operator_matrices.hpp"
 
+#include "fields/dirichlet_values.hpp"
+
 #include <memory>
 
 namespace morphogen {
@@ -15,6 +17,7 @@ class TermList {
 public:
   // state_dependent: the term's coefficients follow the state (refresh() recomputes them).
   void add(std::unique_ptr<Term> t, bool state_dependent = false) {
+    timed_ = timed_ || t->timed_coefficients();
     terms_.push_back(std::move(t));
     state_dependent_ = state_dependent_ || state_dependent;
   }
@@ -47,6 +50,16 @@ public:
   void use_matrices(OperatorMatrices* m) { matrices_ = m; }
   // True when some term has solution-dependent coefficients.
   bool any_state_dependent() const { return state_dependent_; }
+  // Dirichlet values that may depend on t (kept by reference; set_time re-evaluates them).
+  void use_boundary(DirichletValues* b) { boundary_ = b && b->time_dependent() ? b : nullptr; }
+  // True when some coefficient or boundary value depends on t.
+  bool any_time_dependent() const { return timed_ || boundary_; }
+  // Evaluate the time-dependent coefficients (Term::set_time) and Dirichlet values at t; the
+  // matrices given to use_matrices (if any) follow: re-assembled for the species whose
+  // operator changed (appended to `changed` when given), their Dirichlet vectors b_s
+  // recomputed. Returns true when anything changed. Nothing happens (and nothing is spent) in
+  // runs without t. Collective.
+  bool set_time(double t, std::vector<int>* changed = nullptr) const;
   // Largest stable forward-Euler dt of the diffusion terms (min over terms). Collective.
   double stable_dt() const;
   // The pinned-cells constraint, or null.
@@ -61,6 +74,8 @@ private:
   std::vector<std::unique_ptr<Constraint>> constraints_;
   OperatorMatrices* matrices_ = nullptr;
   bool state_dependent_ = false;
+  bool timed_ = false;
+  DirichletValues* boundary_ = nullptr;
 };
 
 } // namespace morphogen

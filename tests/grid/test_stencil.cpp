@@ -5,6 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <string>
+
 using namespace morphogen;
 
 namespace {
@@ -113,5 +116,49 @@ TEST(Stencil, RowFormGroupsTermsByRow) {
       return f(0.1 + dx * hh[0], 0.2 + dy * hh[1], 0.3 + dz * hh[2]);
     });
     EXPECT_NEAR(rows_sum, direct, 1e-10);
+  }
+}
+
+// Symbol of a stencil at wave vector k (h = 1): sum_t w_t cos(k . off_t).
+double symbol(const Stencil& s, const double* k) {
+  double v = 0;
+  for (int t = 0; t < s.nterms; ++t)
+    v += s.w[t] * std::cos(k[0] * s.off[t][0] + k[1] * s.off[t][1] + k[2] * s.off[t][2]);
+  return v;
+}
+
+TEST(Stencil, ThreeDBoxStencilsIsotropicSecondOrder) {
+  const double h[3] = {0.3, 0.3, 0.3}, h1[3] = {1, 1, 1};
+  for (const char* name : {"19pt", "27pt"}) {
+    Stencil s;
+    ASSERT_TRUE(make_stencil(name, 3, h, s)) << name;
+    EXPECT_EQ(s.nterms, std::string(name) == "19pt" ? 19 : 27);
+    EXPECT_NEAR(lap_at(s, h,
+                       [](double x, double y, double z) {
+                         return x * x + 2 * y * y - 0.5 * z * z + x * y * z + 3 * y * z - x;
+                       }),
+                2 + 4 - 1, 1e-10)
+        << name;
+    // Symbol -|k|^2 + |k|^4 / 12 + O(k^6) in every direction (isotropic leading error), where
+    // the 7-point stencil's k^4 term is (kx^4 + ky^4 + kz^4) / 12: 1/12 along an axis, 1/36
+    // along the diagonal.
+    Stencil s1;
+    ASSERT_TRUE(make_stencil(name, 3, h1, s1));
+    const double eps = 0.02, r3 = 1.0 / std::sqrt(3.0);
+    const double axis[3] = {eps, 0, 0}, diag[3] = {eps * r3, eps * r3, eps * r3};
+    for (const double* k : {axis, diag})
+      EXPECT_NEAR((symbol(s1, k) + eps * eps) / std::pow(eps, 4), 1.0 / 12.0, 1e-4) << name;
+    // Spectral radius: 16/3 (19pt, at (pi, pi, 0) and permutations), 184/30 (27pt, at
+    // (pi, pi, pi)), over h^2.
+    EXPECT_NEAR(s1.spectral_radius(), std::string(name) == "19pt" ? 16.0 / 3.0 : 184.0 / 30.0,
+                1e-12);
+    RowStencil r;
+    ASSERT_TRUE(to_rows(s, r));
+    EXPECT_EQ(r.nrows, 9);
+    EXPECT_TRUE(r.box);
+    // Unequal spacing and 2-D are refused.
+    const double hu[3] = {0.3, 0.3, 0.2};
+    EXPECT_FALSE(make_stencil(name, 3, hu, s));
+    EXPECT_FALSE(make_stencil(name, 2, h, s));
   }
 }

@@ -77,12 +77,14 @@ CASES = [
      ["-dt 1", "stability bound dt <= 0.25", "lambda_max = 1", "-integrator split"]),
     ("dt_above_map_bound", GRID + ["-D_a", "0.0625 + x/8", "-dt", "0.5"],
      ["-dt 0.5", "stability bound", "lambda_max", "-force_dt"]),
-    ("tensor_time_dependent", GRID + ["-diffusion", "tensor", "-tensor_l1", "2 + sin(t)"],
-     ["-tensor_l1", "2 + sin(t)", "time-dependent"]),
-    ("tensor_angle_time_dependent", GRID + ["-diffusion", "tensor", "-tensor_theta", "0.1*t"],
-     ["-tensor_theta", "time-dependent"]),
-    ("diffusion_map_time_dependent", GRID + ["-D_a", "0.06*(1 + t)"],
-     ["-D_a", "time-dependent"]),
+    # Tensors and maps may use t (evaluated per step); what is still refused at setup:
+    ("tensor_time_dependent_not_pd_at_start", GRID + ["-diffusion", "tensor", "-tensor_l1",
+                                                      "sin(t) - 0.5"],
+     ["-tensor_theta..tensor_l2", "positive definite", "at cell (0,0) at t = 0", "tensor_l1 = -0.5"]),
+    ("diffusion_time_dependent_polar", GRID + ["-diffusion_a", "polar", "-D_a", "0.06*(1 + t)"],
+     ["-D_a", "0.06*(1 + t)", "not supported with -diffusion_a polar", "allowed with iso and tensor"]),
+    ("diffusion_time_dependent_9pt", GRID + ["-stencil", "9pt", "-D_a", "0.06*(1 + t)"],
+     ["-stencil 9pt", "-D_a", "needs -stencil 5pt"]),
 ]
 
 
