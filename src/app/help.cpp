@@ -95,6 +95,13 @@ const Conditional kConditional[] = {
      "(default rk2; euler is the stable-ARD paper's eq. 20)"},
     {"advect", "-advection_halo W",
      "with -advect: halo width in cells (default 0: from max|u| dt/h at the start; at most 64)"},
+    {"velocity_file", "-velocity_file FILE|A,B,..|S.series, -velocity_datasets X,Y[,Z]",
+     "with -advect: velocity from HDF5/VTKHDF files instead of -velocity_x/_y: one file "
+     "(steady), a comma list or a .series JSON file (linear in t between frames, end frames "
+     "held outside); component datasets (default velocity_x,velocity_y[,velocity_z])"},
+    {"velocity_time", "-velocity_times T1,T2,.., -velocity_time_attribute /object/name",
+     "with a comma list in -velocity_file: the files' times (default: each file's attribute "
+     "/morphogen/time)"},
     {"fluid_", "-fluid_viscosity NU, -fluid_lid_speed U, -fluid_inflow U, -fluid_obstacle EXPR",
      "with -fluid: viscosity (default 0.01), cavity lid speed and channel inflow (default 1), "
      "solid cells where EXPR > 0.5 (default none)"},

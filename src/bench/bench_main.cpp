@@ -311,12 +311,14 @@ DeckRun run_deck(MPI_Comm comm, Options& opt, const OptionPairs& o, PetscInt ste
   return r;
 }
 
-// input/brusselator.yaml to t = 125: explicit dt 0.0025 against split dt 0.1 (species a).
-void bench_brusselator_deck(MPI_Comm comm, Options& opt, double T) {
+// input/brusselator.yaml to t = T: explicit dt 0.0025 against split dt `split_dt` (species a).
+void bench_brusselator_deck(MPI_Comm comm, Options& opt, double T, double split_dt) {
   const PetscInt ex_steps = static_cast<PetscInt>(std::lround(T / 0.0025));
-  const PetscInt sp_steps = static_cast<PetscInt>(std::lround(T / 0.1));
+  const PetscInt sp_steps = static_cast<PetscInt>(std::lround(T / split_dt));
+  char dt_text[32];
+  std::snprintf(dt_text, sizeof dt_text, "%.17g", split_dt);
   const DeckRun ex = run_deck(comm, opt, brusselator_deck(256, "explicit", "0.0025"), ex_steps);
-  const DeckRun sp = run_deck(comm, opt, brusselator_deck(256, "split", "0.1"), sp_steps);
+  const DeckRun sp = run_deck(comm, opt, brusselator_deck(256, "split", dt_text), sp_steps);
   const double dspots = ex.spots ? std::fabs(double(sp.spots - ex.spots)) / ex.spots : 1.0;
   const double dlam = ex.wavelength > 0 ? std::fabs(sp.wavelength / ex.wavelength - 1.0) : 1.0;
   const double speedup = ex.seconds / sp.seconds;
@@ -326,9 +328,10 @@ void bench_brusselator_deck(MPI_Comm comm, Options& opt, double T) {
               "wavelength=%.2f\n",
               T, static_cast<int>(ex_steps), ex.seconds, ex.cls.c_str(), ex.spots, ex.wavelength);
   PetscPrintf(comm,
-              "brusselator_deck T=%g split dt=0.1 steps=%d seconds=%.2f class=%s spots=%ld "
+              "brusselator_deck T=%g split dt=%g steps=%d seconds=%.2f class=%s spots=%ld "
               "wavelength=%.2f\n",
-              T, static_cast<int>(sp_steps), sp.seconds, sp.cls.c_str(), sp.spots, sp.wavelength);
+              T, split_dt, static_cast<int>(sp_steps), sp.seconds, sp.cls.c_str(), sp.spots,
+              sp.wavelength);
   PetscPrintf(comm,
               "brusselator_deck speedup_split_vs_explicit=%.2f target>=4 %s; same pattern "
               "(class, spots +-5%%, wavelength +-2%%): %s (spots %.1f%%, wavelength %.1f%%)\n",
@@ -356,6 +359,8 @@ int run(MPI_Comm comm) {
                "1024^2, and the Brusselator deck (issue 13 part 1)");
   const double deck_T = opt.real("bench_brusselator_T", 125.0, 0.0, 1e6,
                                  "simulated time of the Brusselator deck comparison (0: skip)");
+  const double deck_split_dt = opt.real("bench_brusselator_split_dt", 0.1, 1e-6, 100.0,
+                                        "split step of the Brusselator deck comparison");
   const bool with_scaling = opt.flag(
       "bench_scaling", true,
       "strong scaling on this node (1 rank vs all) and the weak-scaling model for clusters");
@@ -393,7 +398,7 @@ int run(MPI_Comm comm) {
     bench_split_vs_explicit(comm, opt, 256, static_cast<int>(split_steps) * 4);
     opt.check_unused();
     bench_split_vs_explicit(comm, opt, 1024, static_cast<int>(split_steps));
-    if (deck_T > 0) bench_brusselator_deck(comm, opt, deck_T);
+    if (deck_T > 0) bench_brusselator_deck(comm, opt, deck_T, deck_split_dt);
   }
   if (only_implicit) return 0;
   set_case({});

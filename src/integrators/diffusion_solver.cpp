@@ -34,10 +34,11 @@ DiffusionSolver::DiffusionSolver(const Grid& grid, const OperatorMatrices& ops,
     opt.known(name);
   for (size_t s = 0; s < ns; ++s)
     configure(static_cast<int>(s));
-  choose_spectral(opt.choice("diffusion_solver", "auto", {"auto", "ksp", "spectral"},
-                             "diffusion substep solver: spectral (exact FFT solve; one rank, "
-                             "periodic, constant coefficients), ksp, or auto (spectral where it "
-                             "applies and no -diffusion_ksp_*/-diffusion_pc_* option is given)"));
+  choose_spectral(
+      opt.choice("diffusion_solver", "auto", {"auto", "ksp", "spectral"},
+                 "diffusion substep solver: spectral (exact FFT/DCT solve; periodic "
+                 "or zero-flux axes, constant coefficients), ksp, or auto (spectral where it "
+                 "applies and no -diffusion_ksp_*/-diffusion_pc_* option is given)"));
 }
 
 void DiffusionSolver::choose_spectral(const std::string& mode) {
@@ -70,7 +71,7 @@ void DiffusionSolver::choose_spectral(const std::string& mode) {
                       "; allowed here: ksp or auto");
     if (spectral_[s]) spectral_mat_[s] = ops_.M(s);
     PetscPrintf(grid_.comm(), "  diffusion solve of %s: %s\n", species_[s].c_str(),
-                spectral_[s] ? "spectral (FFT, exact)" : ("ksp (" + why + ")").c_str());
+                spectral_[s] ? "spectral (FFT/DCT, exact)" : ("ksp (" + why + ")").c_str());
   }
 }
 

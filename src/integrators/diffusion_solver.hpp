@@ -15,12 +15,12 @@
 // -diffusion_ksp_* and -diffusion_pc_* options (e.g. -diffusion_pc_type mg for geometric multigrid
 // on the DMDA, -diffusion_pc_type hypre, or -diffusion_ksp_type richardson -diffusion_pc_type
 // jacobi or sor for Sanderson's relaxation). A diverged solve is reported with species, KSP reason
-// and iteration count. -diffusion_solver auto|ksp|spectral: on one rank, a species whose matrix is
-// a periodic constant-coefficient stencil (checked numerically, spectral_diffusion.hpp) is solved
-// exactly by FFT instead (auto: wherever it applies and no -diffusion_ksp_*/-diffusion_pc_*
-// option is given, else KSP; spectral: an error where it does not apply). A species whose matrix is
-// later re-assembled (operator_changed) or modified goes back to KSP. The choice per species is
-// printed at setup.
+// and iteration count. -diffusion_solver auto|ksp|spectral: a species whose matrix is a
+// constant-coefficient stencil on periodic / zero-flux axes (checked numerically,
+// spectral_diffusion.hpp) is solved exactly by FFT/DCT instead, on any number of ranks (auto:
+// wherever it applies and no -diffusion_ksp_*/-diffusion_pc_* option is given, else KSP; spectral:
+// an error where it does not apply). A species whose matrix is later re-assembled
+// (operator_changed) or modified goes back to KSP. The choice per species is printed at setup.
 #pragma once
 
 #include "core/options.hpp"

@@ -4,141 +4,127 @@
 
 #include <algorithm>
 #include <cmath>
-#include <complex>
-#include <fftw3.h>
 
 namespace morphogen {
 
-// FFTW's real transforms of the grid (dims slowest first: z, y, x), planned once.
-struct SpectralDiffusion::Fft {
-  size_t ncell = 1, nspec = 1;
-  double* real = nullptr;
-  fftw_complex* spec = nullptr;
-  fftw_plan fwd = nullptr, bwd = nullptr;
-  Fft(int rank, const int* dims) {
-    for (int d = 0; d < rank; ++d)
-      ncell *= static_cast<size_t>(dims[d]);
-    nspec =
-        ncell / static_cast<size_t>(dims[rank - 1]) * static_cast<size_t>(dims[rank - 1] / 2 + 1);
-    real = fftw_alloc_real(ncell);
-    spec = fftw_alloc_complex(nspec);
-    fwd = fftw_plan_dft_r2c(rank, dims, real, spec, FFTW_ESTIMATE);
-    bwd = fftw_plan_dft_c2r(rank, dims, spec, real, FFTW_ESTIMATE);
-  }
-  ~Fft() {
-    if (fwd) fftw_destroy_plan(fwd);
-    if (bwd) fftw_destroy_plan(bwd);
-    fftw_free(real);
-    fftw_free(spec);
-  }
-  // spec = FFT(x) of a Vec's values; x = IFFT(spec) (unnormalised) back into a Vec.
-  void forward(Vec x) {
-    const PetscScalar* a;
-    MG_PETSC(VecGetArrayRead(x, &a));
-    std::copy(a, a + ncell, real);
-    MG_PETSC(VecRestoreArrayRead(x, &a));
-    fftw_execute(fwd);
-  }
-  void backward(Vec x) {
-    fftw_execute(bwd); // destroys spec
-    PetscScalar* a;
-    MG_PETSC(VecGetArray(x, &a));
-    std::copy(real, real + ncell, a);
-    MG_PETSC(VecRestoreArray(x, &a));
-  }
-};
-
 namespace {
 
-// A deterministic, non-smooth test vector (every Fourier mode present).
-void fill_probe(Vec x) {
-  PetscInt n;
+// A deterministic, non-smooth test vector (every mode present), a function of the global cell.
+void fill_probe(const Grid& grid, Vec x) {
+  const Box& ob = grid.owned();
   PetscScalar* a;
-  MG_PETSC(VecGetLocalSize(x, &n));
   MG_PETSC(VecGetArray(x, &a));
-  for (PetscInt i = 0; i < n; ++i)
-    a[i] = std::sin(0.7 * static_cast<double>(i) + 0.3 * static_cast<double>(i % 7)) + 0.1;
+  for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
+    for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j)
+      for (PetscInt i = ob.s[0]; i < ob.s[0] + ob.m[0]; ++i) {
+        const double n = static_cast<double>(grid.natural_index(i, j, k));
+        a[grid.owned_index(i, j, k)] = std::sin(0.7 * n + 0.3 * std::fmod(n, 7.0)) + 0.1;
+      }
   MG_PETSC(VecRestoreArray(x, &a));
+}
+
+double max_all(MPI_Comm comm, double v) {
+  double r = v;
+  MPI_Allreduce(&v, &r, 1, MPI_DOUBLE, MPI_MAX, comm);
+  return r;
 }
 
 } // namespace
 
-SpectralDiffusion::SpectralDiffusion(std::unique_ptr<Fft> fft) : fft_(std::move(fft)) {}
+SpectralDiffusion::SpectralDiffusion(std::unique_ptr<SpectralTransform> t) : t_(std::move(t)) {}
 SpectralDiffusion::~SpectralDiffusion() = default;
 
 std::unique_ptr<SpectralDiffusion> SpectralDiffusion::create(const Grid& grid, Mat M,
                                                              std::string* why) {
-  int size = 1;
-  MPI_Comm_size(grid.comm(), &size);
-  if (size > 1) {
-    *why = "more than one rank (the FFT solve is serial)";
-    return nullptr;
-  }
-  const Box& ob = grid.owned();
-  int dims[3], rank = grid.dim();
-  for (int d = 0; d < rank; ++d)
-    dims[d] = static_cast<int>(ob.m[rank - 1 - d]);
-  std::unique_ptr<SpectralDiffusion> sp(new SpectralDiffusion(std::make_unique<Fft>(rank, dims)));
-  Fft& f = *sp->fft_;
-  // lambda = FFT(M e_0): the stencil's symbol, if M is circulant.
-  VecH e = grid.create_global(), y = grid.create_global();
-  MG_PETSC(VecSet(e, 0.0));
-  MG_PETSC(VecSetValue(e, 0, 1.0, INSERT_VALUES));
-  MG_PETSC(VecAssemblyBegin(e));
-  MG_PETSC(VecAssemblyEnd(e));
-  MG_PETSC(MatMult(M, e, y));
-  f.forward(y);
-  sp->lambda_.resize(f.nspec);
-  double lmax = 0.0, imax = 0.0, lpos = 0.0;
-  for (size_t k = 0; k < f.nspec; ++k) {
-    sp->lambda_[k] = f.spec[k][0];
-    lmax = std::max(lmax, std::fabs(f.spec[k][0]));
-    imax = std::max(imax, std::fabs(f.spec[k][1]));
-    lpos = std::max(lpos, f.spec[k][0]);
-  }
-  if (!(lmax > 0.0) || imax > 1e-12 * lmax || lpos > 1e-12 * lmax) {
-    *why = "the operator is not symmetric and dissipative";
-    return nullptr;
-  }
-  // M x against IFFT(lambda FFT(x)) / N for a probe x.
-  fill_probe(e);
-  MG_PETSC(MatMult(M, e, y));
-  f.forward(e);
-  for (size_t k = 0; k < f.nspec; ++k)
-    for (int c = 0; c < 2; ++c)
-      f.spec[k][c] *= sp->lambda_[k] / static_cast<double>(f.ncell);
-  VecH z = grid.create_global();
-  f.backward(z);
-  PetscReal dnorm, ynorm;
-  MG_PETSC(VecAXPY(z, -1.0, y));
-  MG_PETSC(VecNorm(z, NORM_INFINITY, &dnorm));
-  MG_PETSC(VecNorm(y, NORM_INFINITY, &ynorm));
-  if (!(dnorm <= 1e-10 * lmax * 1.5)) { // |probe| <= 1.1, so |M x| <= 1.1 lmax
-    *why = "the operator is not a periodic constant-coefficient stencil (M x differs from the "
-           "FFT product by " +
-           std::to_string(dnorm) + ")";
-    return nullptr;
-  }
-  (void)ynorm;
+  for (int d = 0; d < grid.dim(); ++d)
+    if (grid.spec().bc[d] == Boundary::Dirichlet) {
+      *why = "a Dirichlet axis";
+      return nullptr;
+    }
+  std::unique_ptr<SpectralDiffusion> sp(
+      new SpectralDiffusion(std::make_unique<SpectralTransform>(grid)));
+  if (!sp->measure_symbol(grid, M, why) || !sp->check_product(grid, M, why)) return nullptr;
   return sp;
 }
 
+// lambda = T(M v) / T(v), v = T^-1(1); real and <= 0 (to 1e-12 of max |lambda|) or refused.
+bool SpectralDiffusion::measure_symbol(const Grid& grid, Mat M, std::string* why) {
+  SpectralTransform& t = *t_;
+  const size_t n = t.entries(), w = static_cast<size_t>(t.width());
+  double* sp = t.spectrum();
+  for (size_t e = 0; e < n; ++e)
+    for (size_t c = 0; c < w; ++c)
+      sp[e * w + c] = c == 0 ? 1.0 : 0.0;
+  VecH v = grid.create_global(), y = grid.create_global();
+  t.backward(v);
+  MG_PETSC(MatMult(M, v, y));
+  t.forward(v);
+  const std::vector<double> tv(sp, sp + n * w);
+  t.forward(y);
+  lambda_.resize(n);
+  double lmax = 0.0, imax = 0.0, lpos = 0.0;
+  for (size_t e = 0; e < n; ++e) {
+    const double a = sp[e * w], b = w == 2 ? sp[e * w + 1] : 0.0;
+    const double c = tv[e * w], d = w == 2 ? tv[e * w + 1] : 0.0, q = c * c + d * d;
+    lambda_[e] = (a * c + b * d) / q;
+    imax = std::max(imax, std::fabs((b * c - a * d) / q));
+    lmax = std::max(lmax, std::fabs(lambda_[e]));
+    lpos = std::max(lpos, lambda_[e]);
+  }
+  MPI_Comm comm = grid.comm();
+  lmax = max_all(comm, lmax);
+  imax = max_all(comm, imax);
+  lpos = max_all(comm, lpos);
+  if (!(lmax > 0.0) || !(imax <= 1e-12 * lmax) || !(lpos <= 1e-12 * lmax)) {
+    *why = "the operator is not symmetric and dissipative in the transform's basis";
+    return false;
+  }
+  lmax_ = lmax;
+  return true;
+}
+
+// M x against T^-1(lambda T(x)) / norm for a probe x, to 1e-10 of max |lambda|.
+bool SpectralDiffusion::check_product(const Grid& grid, Mat M, std::string* why) {
+  SpectralTransform& t = *t_;
+  VecH x = grid.create_global(), y = grid.create_global(), z = grid.create_global();
+  fill_probe(grid, x);
+  MG_PETSC(MatMult(M, x, y));
+  t.forward(x);
+  double* sp = t.spectrum();
+  const size_t w = static_cast<size_t>(t.width());
+  for (size_t e = 0; e < t.entries(); ++e)
+    for (size_t c = 0; c < w; ++c)
+      sp[e * w + c] *= lambda_[e] / t.norm();
+  t.backward(z);
+  PetscReal dnorm;
+  MG_PETSC(VecAXPY(z, -1.0, y));
+  MG_PETSC(VecNorm(z, NORM_INFINITY, &dnorm));
+  if (!(dnorm <= 1e-10 * lmax_ * 1.5)) { // |probe| <= 1.1, so |M x| <= 1.1 lmax
+    *why = "the operator is not a constant-coefficient stencil diagonal in the DFT/DCT basis "
+           "(M x differs from the spectral product by " +
+           std::to_string(dnorm) + ")";
+    return false;
+  }
+  return true;
+}
+
 void SpectralDiffusion::solve(Vec u, double c, double theta) {
-  Fft& f = *fft_;
+  SpectralTransform& t = *t_;
+  const size_t n = t.entries(), w = static_cast<size_t>(t.width());
   if (c != gain_c_ || theta != gain_theta_) {
-    gain_.resize(f.nspec);
-    const double inv_n = 1.0 / static_cast<double>(f.ncell);
-    for (size_t k = 0; k < f.nspec; ++k)
-      gain_[k] = inv_n * (1.0 + (1.0 - theta) * c * lambda_[k]) / (1.0 - theta * c * lambda_[k]);
+    gain_.resize(n);
+    const double inv_n = 1.0 / t.norm();
+    for (size_t e = 0; e < n; ++e)
+      gain_[e] = inv_n * (1.0 + (1.0 - theta) * c * lambda_[e]) / (1.0 - theta * c * lambda_[e]);
     gain_c_ = c;
     gain_theta_ = theta;
   }
-  f.forward(u);
-  for (size_t k = 0; k < f.nspec; ++k) {
-    f.spec[k][0] *= gain_[k];
-    f.spec[k][1] *= gain_[k];
-  }
-  f.backward(u);
+  t.forward(u);
+  double* sp = t.spectrum();
+  for (size_t e = 0; e < n; ++e)
+    for (size_t k = 0; k < w; ++k)
+      sp[e * w + k] *= gain_[e];
+  t.backward(u);
 }
 
 } // namespace morphogen

@@ -1,24 +1,24 @@
-// Exact solve of one implicit diffusion substep by FFT (one rank, periodic, constant
-// coefficients):
+// Exact solve of one implicit diffusion substep by a separable transform (spectral_transform.hpp:
+// DFT on periodic axes, DCT-II on zero-flux axes; any number of ranks):
 //
 //   (I - theta c M) u_new = (I + (1 - theta) c M) u,    c = dt scale_s,
 //
-// where M (the species' operator matrix, operators/operator_matrices.hpp) is a convolution with
-// one stencil on a periodic grid (a circulant matrix), so that the discrete Fourier modes are its
-// eigenvectors: with lambda_k = FFT(M e_0)_k (real for a symmetric stencil),
+// where M (the species' operator matrix, operators/operator_matrices.hpp) is diagonal in the
+// transform's basis when it is a constant-coefficient symmetric stencil (periodic axes: a
+// circulant; zero-flux axes: the mirror ghost rule): with lambda_k its eigenvalues,
 //
-//   u_new = IFFT( (1 + (1 - theta) c lambda_k) / (1 - theta c lambda_k) FFT(u)_k ).
+//   u_new = T^-1( (1 + (1 - theta) c lambda_k) / (1 - theta c lambda_k) T(u)_k ).
 //
-// This is the KSP solve's answer to rounding (no iteration, no tolerance): two real FFTs (FFTW
-// r2c/c2r, planned once) and one pass over the spectrum per species and substep.
-// Eligibility is checked numerically at setup, not assumed from the options: M x must equal the
-// spectral product for a non-trivial x to 1e-10 relative (this rejects non-periodic axes, pinned
-// cells, spatially varying coefficients and any stencil that is not translation invariant),
-// lambda_k must be real and <= 0 (a dissipative symmetric operator). create() returns null and
-// says why otherwise; the caller then uses KSP.
+// This is the KSP solve's answer to rounding (no iteration, no tolerance). lambda is measured,
+// not assumed: lambda = T(M v) / T(v) for v = T^-1(1) (so T(v) = 1 and the division is
+// well-conditioned). Eligibility is checked numerically at setup: M x must equal the spectral
+// product for a non-trivial x to 1e-10 relative (this rejects pinned cells, spatially varying
+// coefficients, cross terms on zero-flux axes and any stencil that is not diagonal), lambda_k must
+// be real and <= 0 (a dissipative symmetric operator). create() returns null and says why
+// otherwise; the caller then uses KSP.
 #pragma once
 
-#include "grid/grid.hpp"
+#include "integrators/spectral_transform.hpp"
 
 #include <memory>
 #include <petscmat.h>
@@ -29,7 +29,7 @@ namespace morphogen {
 
 class SpectralDiffusion {
 public:
-  // Null (and *why set) when M is not diagonalised by the FFT on this grid, or on > 1 rank.
+  // Null (and *why set) when M is not diagonalised by the transform on this grid.
   static std::unique_ptr<SpectralDiffusion> create(const Grid& grid, Mat M, std::string* why);
   ~SpectralDiffusion();
   SpectralDiffusion(const SpectralDiffusion&) = delete;
@@ -39,11 +39,12 @@ public:
   void solve(Vec u, double c, double theta);
 
 private:
-  struct Fft;
-  explicit SpectralDiffusion(std::unique_ptr<Fft> fft);
-  std::unique_ptr<Fft> fft_;
-  std::vector<double> lambda_, gain_;
-  double gain_c_ = -1.0, gain_theta_ = -1.0;
+  explicit SpectralDiffusion(std::unique_ptr<SpectralTransform> t);
+  bool measure_symbol(const Grid& grid, Mat M, std::string* why);
+  bool check_product(const Grid& grid, Mat M, std::string* why);
+  std::unique_ptr<SpectralTransform> t_;
+  std::vector<double> lambda_, gain_; // per spectral entry of this rank
+  double gain_c_ = -1.0, gain_theta_ = -1.0, lmax_ = 0.0;
 };
 
 } // namespace morphogen

@@ -8,8 +8,13 @@ namespace morphogen {
 
 namespace {
 
-const char* kOptions[] = {"advection_scheme", "advection_backtrace", "advection_halo",
-                          "velocity_x",       "velocity_y",          "velocity_z"};
+const char* kOptions[] = {"advection_scheme", "advection_backtrace",
+                          "advection_halo",   "velocity_x",
+                          "velocity_y",       "velocity_z",
+                          "velocity_file",    "velocity_datasets",
+                          "velocity_times",   "velocity_time_attribute"};
+const char* kExpressions[] = {"velocity_x", "velocity_y", "velocity_z"};
+const char* kFileOptions[] = {"velocity_datasets", "velocity_times", "velocity_time_attribute"};
 
 std::string joined(const std::vector<std::string>& v) {
   std::string s;
@@ -34,6 +39,30 @@ void read_species(Options& opt, const std::string& text, const std::vector<std::
     set.species.push_back(s);
     set.names.push_back(n);
   }
+}
+
+// -velocity_file, or null. Refused beside -fluid or -velocity_x/_y/_z; its companions
+// (-velocity_datasets, ...) are refused without it.
+std::unique_ptr<VelocityFile> read_velocity_file(Options& opt, const Grid& grid,
+                                                 const std::string& base_dir,
+                                                 const VelocitySource* fluid) {
+  const auto file = opt.get("velocity_file",
+                            "advection velocity from HDF5 files: one file (steady), a comma list "
+                            "or a .series JSON file (linear in t between frames)");
+  if (!file) {
+    for (const char* k : kFileOptions)
+      if (opt.is_set(k))
+        throw UserError(std::string("-") + k + ": applies with -velocity_file only");
+    return nullptr;
+  }
+  if (fluid)
+    throw UserError("-velocity_file " + *file + ": the velocity comes from " +
+                    fluid->option_text() + "; drop -velocity_file or the fluid");
+  for (const char* k : kExpressions)
+    if (opt.is_set(k))
+      throw UserError(std::string("-") + k + ": the velocity comes from -velocity_file " + *file +
+                      "; drop -" + k + " or -velocity_file");
+  return std::make_unique<VelocityFile>(grid, opt, *file, base_dir);
 }
 
 } // namespace
@@ -67,6 +96,8 @@ std::unique_ptr<AdvectionStage> read_advection(Options& opt, const Grid& grid,
       opt.integer("advection_halo", 0, 0, AdvectionSettings::kMaxHalo,
                   "halo of the advected species in cells (0: from the largest Courant number "
                   "max|u| dt/h at the start, plus the interpolation stencil)"));
+  if (auto file = read_velocity_file(opt, grid, base_dir, fluid))
+    return std::make_unique<AdvectionStage>(grid, std::move(file), std::move(set), dt);
   if (fluid) {
     for (const char* k : {"velocity_x", "velocity_y", "velocity_z"})
       if (opt.is_set(k))

@@ -4,7 +4,10 @@
 //   -advection_backtrace rk2|euler    departure point: midpoint rule (default) or the paper's
 //                                     eq. 20 (one Euler step back)
 //   -advection_halo W                 halo width in cells (default: sized from max|u| dt / h)
-//   -velocity_x/_y/_z EXPR            the velocity (fields/velocity_field.hpp)
+//   -velocity_x/_y/_z EXPR            the velocity (fields/velocity_field.hpp), or
+//   -velocity_file F [-velocity_datasets X,Y]  the velocity from HDF5 files
+//                                     (fields/velocity_file.hpp; refused beside -velocity_x or
+//                                     -fluid)
 // Without -advect the other options are refused with a one-line UserError.
 #pragma once
 

@@ -32,6 +32,14 @@ AdvectionStage::AdvectionStage(const Grid& grid, std::unique_ptr<VelocityField> 
   checked_dt_ = dt;
 }
 
+AdvectionStage::AdvectionStage(const Grid& grid, std::unique_ptr<VelocityFile> file,
+                               AdvectionSettings settings, double dt)
+    : grid_(grid), file_(std::move(file)), set_(std::move(settings)) {
+  setup(file_->max_abs(), dt);
+  load_velocity(0.5 * dt);
+  checked_dt_ = dt;
+}
+
 AdvectionStage::AdvectionStage(const Grid& grid, const VelocitySource& source,
                                AdvectionSettings settings, double dt)
     : grid_(grid), source_(&source), set_(std::move(settings)) {
@@ -79,6 +87,10 @@ void AdvectionStage::load_velocity(double t) {
       MG_PETSC(VecGetArrayRead(source_->component(d), &a));
       wide_->fill(a, u_[d].data());
       MG_PETSC(VecRestoreArrayRead(source_->component(d), &a));
+    } else if (file_) {
+      owned_.resize(static_cast<size_t>(grid_.owned().size()));
+      file_->owned(d, t, owned_.data());
+      spread_owned(owned_, u_[d].data());
     } else {
       velocity_->evaluate(d, wide_->box(), t, u_[d].data());
     }
@@ -86,6 +98,17 @@ void AdvectionStage::load_velocity(double t) {
   for (int d = grid_.dim(); d < 3; ++d)
     u_[d].assign(static_cast<size_t>(wide_->size()), 0.0);
   dep_dt_ = -1.0;
+}
+
+// Owned values (owned layout) onto the wide box, through a ghosted-layout buffer.
+void AdvectionStage::spread_owned(const std::vector<double>& owned, double* wide) {
+  const Box& ob = grid_.owned();
+  local_.assign(static_cast<size_t>(grid_.ghosted().size()), 0.0);
+  const double* o = owned.data();
+  for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
+    for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j, o += ob.m[0])
+      std::copy(o, o + ob.m[0], local_.begin() + grid_.local_index(ob.s[0], j, k));
+  wide_->fill(local_.data(), wide);
 }
 
 // The velocity on the wide box (evaluated at t) with step dt: its back-trace must fit the halo.
@@ -105,13 +128,16 @@ void AdvectionStage::check_reach(double dt, double t) {
   if (need <= wide_->width()) return;
   const std::string what =
       source_ ? source_->option_text() + ": the fluid velocity"
+      : file_ ? file_->option_text() + ": the velocity"
               : "-velocity_" + std::string(kAxis[axis]) + " " + velocity_->text(axis);
   throw UserError(what + ": at t = " + format_number(t) + " the advection back-trace of -dt " +
                   format_number(dt) + " reaches " + std::to_string(need) +
                   " cells (Courant number " + format_number(courant_) +
                   "), more than the advection halo (" + std::to_string(wide_->width()) +
                   " cells, " +
-                  (set_.halo > 0 ? "-advection_halo" : "sized from the velocity at the start") +
+                  (set_.halo > 0 ? "-advection_halo"
+                   : file_       ? "sized from the files' largest speed and the first -dt"
+                                 : "sized from the velocity at the start") +
                   "); set -advection_halo " + std::to_string(need) + " (at most " +
                   std::to_string(AdvectionSettings::kMaxHalo) + ") or a smaller -dt");
 }
@@ -150,7 +176,7 @@ void AdvectionStage::apply(std::vector<VecH>& u, double t, double dt) {
   if (source_) {
     load_velocity(t + dt);
     check_reach(dt, t + dt);
-  } else if (velocity_->uses_time()) {
+  } else if (file_ ? file_->uses_time() : velocity_->uses_time()) {
     load_velocity(t + 0.5 * dt);
     check_reach(dt, t + 0.5 * dt);
   } else if (dt != checked_dt_) {
@@ -175,9 +201,10 @@ std::string AdvectionStage::describe() const {
   for (const auto& n : set_.names)
     names += (names.empty() ? "" : ",") + n;
   std::string vel;
-  for (int d = 0; d < grid_.dim() && !source_; ++d)
+  for (int d = 0; d < grid_.dim() && velocity_; ++d)
     vel += (d ? ", " : "") + std::string("u_") + kAxis[d] + " = " + velocity_->text(d);
   if (source_) vel = "velocity of " + source_->option_text();
+  if (file_) vel = file_->describe();
   return "advection of " + names + " (semi-Lagrangian, " +
          (set_.interp == advect::Interp::Cubic ? "cubic" : "linear") + ", " +
          (set_.backtrace == advect::Backtrace::Rk2 ? "rk2" : "euler") + " back-trace; " + vel +

@@ -13,12 +13,16 @@
 //
 // The velocity is evaluated on the wide box once (steady) or once per step at the step's
 // midpoint t + dt/2 (velocity using t); departure points of a steady velocity are computed once
-// per dt and reused. A velocity computed by the run (VelocitySource: the stable-fluids solver)
+// per dt and reused. A velocity read from files (fields/velocity_file.hpp) is taken like an
+// expression: once (one file) or per step at t + dt/2 (a series, linear in t between frames),
+// each rank's owned cells spread through the wide halo; the halo is sized from the largest
+// speed over all frames. A velocity computed by the run (VelocitySource: the stable-fluids solver)
 // is instead spread from its owned cells through the same wide halo at every step (its state
 // at the end of the fluid's step), its reach checked and its departure points recomputed.
 #pragma once
 
 #include "fields/velocity_field.hpp"
+#include "fields/velocity_file.hpp"
 #include "grid/wide_halo.hpp"
 #include "operators/advection_kernel.hpp"
 #include "operators/velocity_source.hpp"
@@ -43,6 +47,9 @@ public:
   // Collective; throws UserError when dt's back-trace does not fit the halo.
   AdvectionStage(const Grid& grid, std::unique_ptr<VelocityField> velocity,
                  AdvectionSettings settings, double dt);
+  // The velocity read from files (halo sized from their largest speed). Collective.
+  AdvectionStage(const Grid& grid, std::unique_ptr<VelocityFile> file, AdvectionSettings settings,
+                 double dt);
   // The velocity of `source` (which outlives the stage), read at every apply(). Collective.
   AdvectionStage(const Grid& grid, const VelocitySource& source, AdvectionSettings settings,
                  double dt);
@@ -63,17 +70,20 @@ private:
   void setup(const std::array<double, 3>& umax, double dt);
   void load_velocity(double t);
   void check_reach(double dt, double t);
+  void spread_owned(const std::vector<double>& owned, double* wide);
   void compute_departures(double dt);
   void transport(Vec v);
 
   const Grid& grid_;
-  std::unique_ptr<VelocityField> velocity_; // expressions (null with a source)
+  std::unique_ptr<VelocityField> velocity_; // expressions (null with a source or a file)
+  std::unique_ptr<VelocityFile> file_;      // files (null otherwise)
   const VelocitySource* source_ = nullptr;  // a velocity computed by the run
   AdvectionSettings set_;
   std::unique_ptr<WideHalo> wide_;
   advect::WideGeom geom_;
   std::array<std::vector<double>, 3> u_; // velocity on the wide box
   std::vector<double> w_;                // a species on the wide box
+  std::vector<double> owned_, local_;    // a file velocity component: owned, ghosted layout
   std::vector<double> dep_;              // departure point of each owned cell (3 per cell)
   double dep_dt_ = -1.0;                 // dt of dep_ (< 0: stale)
   double checked_dt_ = -1.0;             // dt whose reach was checked (steady velocity)

@@ -1,12 +1,16 @@
-// The FFT diffusion solve (integrators/spectral_diffusion.hpp, -diffusion_solver), on 1 and
-// 2 ranks, pure diffusion (-params_s 0) with the split integrator (Crank-Nicolson):
-//   1. one Fourier mode sin(2 pi m x / Lx) sin(2 pi q y / Ly) after N steps equals the
-//      closed form g^N, g = (1 + c lambda / 2) / (1 - c lambda / 2), lambda the 5-point
-//      symbol -4/h^2 sin^2(pi m / n) (each axis), to 1e-12 (1 rank: spectral by default);
-//   2. a rough field (uniform +-20 % noise, every mode) on non-square periodic grids (2-D 5pt and
-//      9pt, 3-D 7pt), spectral against KSP at rtol 1e-13: max difference <= 1e-10;
-//   3. where it does not apply (2 ranks, Neumann axes) auto uses KSP and -diffusion_solver
-//      spectral is a UserError naming the option.
+// The FFT/DCT diffusion solve (integrators/spectral_diffusion.hpp, -diffusion_solver), on 1, 2
+// and 4 ranks, pure diffusion (-params_s 0) with the split integrator (Crank-Nicolson):
+//   1. one Fourier mode sin(2 pi m x / Lx) sin(2 pi q y / Ly) (periodic) or cosine mode
+//      cos(pi m x / Lx) cos(pi q y / Ly) (zero flux) after N steps equals the closed form g^N,
+//      g = (1 + c lambda / 2) / (1 - c lambda / 2), lambda the 5-point symbol (each axis
+//      -4/h^2 sin^2(pi m / n), resp. sin^2(pi m / (2 n))), to 1e-12;
+//   2. a rough field (uniform +-20 % noise, every mode) on non-square grids (2-D 5pt and 9pt,
+//      periodic and zero flux, a rotated constant tensor with cross terms on a periodic grid;
+//      3-D 7pt periodic and mixed periodic / zero flux), spectral against KSP at rtol 1e-13:
+//      max difference <= 1e-10;
+//   3. where it does not apply (Dirichlet axes, varying coefficients, a tensor's cross terms on
+//      zero-flux axes) auto uses KSP and -diffusion_solver spectral is a UserError naming the
+//      option.
 #include "../mpi_expect.hpp"
 #include "../sim_fixture.hpp"
 #include "core/user_error.hpp"
@@ -47,15 +51,20 @@ std::unique_ptr<Simulation> run(OptionList opts, int steps) {
 
 } // namespace
 
-TEST(SpectralDiffusion, FourierModeMatchesTheClosedForm) {
-  if (comm_size() > 1) GTEST_SKIP() << "the FFT solve is serial";
+// Max |a - g^steps mode(x, y)| over the grid for species a after `steps` steps.
+double mode_error(const std::string& bc, int steps) {
   // 32 x 24 cells, L = 8 x 6 (h = 0.25), mode (m, q) = (3, 2), species a: D = 0.7.
-  const int steps = 6;
-  auto sim = run(diffusion_case("32,24", "8,6", "sin(2*pi*3*x/8)*sin(2*pi*2*y/6)", "auto"), steps);
-  ASSERT_TRUE(sim->diffusion_solver()->spectral(0));
-  const double h = 0.25, c = 0.05 * 0.7;
-  const double lam = -4.0 / (h * h) *
-                     (std::pow(std::sin(M_PI * 3 / 32), 2) + std::pow(std::sin(M_PI * 2 / 24), 2));
+  const bool periodic = bc == "periodic";
+  const std::string mode =
+      periodic ? "sin(2*pi*3*x/8)*sin(2*pi*2*y/6)" : "cos(pi*3*x/8)*cos(pi*2*y/6)";
+  OptionList o = diffusion_case("32,24", "8,6", mode, "auto");
+  o.push_back({"grid_bc", bc});
+  auto sim = run(o, steps);
+  EXPECT_TRUE(all_ranks(sim->diffusion_solver()->spectral(0)));
+  const double h = 0.25, c = 0.05 * 0.7, f = periodic ? 1.0 : 0.5;
+  const double lam =
+      -4.0 / (h * h) *
+      (std::pow(std::sin(f * M_PI * 3 / 32), 2) + std::pow(std::sin(f * M_PI * 2 / 24), 2));
   const double g = std::pow((1.0 + 0.5 * c * lam) / (1.0 - 0.5 * c * lam), steps);
   const Grid& grid = sim->grid();
   const Box& ob = grid.owned();
@@ -65,29 +74,50 @@ TEST(SpectralDiffusion, FourierModeMatchesTheClosedForm) {
   for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j)
     for (PetscInt i = ob.s[0]; i < ob.s[0] + ob.m[0]; ++i) {
       const double x = (i + 0.5) * h, y = (j + 0.5) * h;
-      const double exact = g * std::sin(2 * M_PI * 3 * x / 8) * std::sin(2 * M_PI * 2 * y / 6);
-      err = std::max(err, std::fabs(a[grid.local_index(i, j, 0)] - exact));
+      const double shape = periodic
+                               ? std::sin(2 * M_PI * 3 * x / 8) * std::sin(2 * M_PI * 2 * y / 6)
+                               : std::cos(M_PI * 3 * x / 8) * std::cos(M_PI * 2 * y / 6);
+      err = std::max(err, std::fabs(a[grid.local_index(i, j, 0)] - g * shape));
     }
   VecRestoreArrayRead(sim->state()[0], &a);
-  EXPECT_LT(err, 1e-12);
+  return max_over_ranks(err);
+}
+
+TEST(SpectralDiffusion, FourierModeMatchesTheClosedForm) {
+  EXPECT_LT(mode_error("periodic", 6), 1e-12);
+}
+
+TEST(SpectralDiffusion, CosineModeMatchesTheClosedFormOnZeroFluxAxes) {
+  EXPECT_LT(mode_error("neumann", 6), 1e-12);
 }
 
 TEST(SpectralDiffusion, AgreesWithKspOnRoughFields) {
-  if (comm_size() > 1) GTEST_SKIP() << "the FFT solve is serial";
   struct Case {
-    const char *n, *L, *stencil;
+    const char *n, *L, *stencil, *bc;
+    bool tensor;
   };
-  for (const Case& k : {Case{"20,12", "5,3", "5pt"}, Case{"16,10", "4,2.5", "9pt"},
-                        Case{"10,8,6", "2.5,2,1.5", "7pt"}}) {
-    SCOPED_TRACE(std::string(k.n) + " " + k.stencil);
+  for (const Case& k : {Case{"20,12", "5,3", "5pt", "periodic", false},
+                        Case{"16,10", "4,2.5", "9pt", "periodic", false},
+                        Case{"18,11", "4.5,2.75", "5pt", "neumann", false},
+                        Case{"16,10", "4,2.5", "9pt", "neumann,periodic", false},
+                        Case{"20,12", "5,3", "5pt", "periodic", true},
+                        Case{"10,8,6", "2.5,2,1.5", "7pt", "periodic", false},
+                        Case{"10,8,7", "2.5,2,1.75", "7pt", "periodic,neumann,periodic", false}}) {
+    SCOPED_TRACE(std::string(k.n) + " " + k.stencil + " " + k.bc + (k.tensor ? " tensor" : ""));
     auto with = [&](const char* solver) {
       OptionList o = diffusion_case(k.n, k.L, "1 +- 20%", solver);
       o.push_back({"stencil", k.stencil});
+      o.push_back({"grid_bc", k.bc});
+      if (k.tensor)
+        o.insert(o.end(), {{"diffusion", "tensor"},
+                           {"tensor_theta", "0.4"},
+                           {"tensor_l1", "1.6"},
+                           {"tensor_l2", "0.5"}});
       return run(o, 4);
     };
     auto sp = with("spectral"), ksp = with("ksp");
-    ASSERT_TRUE(sp->diffusion_solver()->spectral(0));
-    ASSERT_TRUE(sp->diffusion_solver()->spectral(1));
+    ASSERT_TRUE(all_ranks(sp->diffusion_solver()->spectral(0)));
+    ASSERT_TRUE(all_ranks(sp->diffusion_solver()->spectral(1)));
     ASSERT_FALSE(ksp->diffusion_solver()->spectral(0));
     for (int s = 0; s < 2; ++s) {
       const auto a = gather_all(sp->grid(), sp->state()[s]);
@@ -104,23 +134,27 @@ TEST(SpectralDiffusion, AgreesWithKspOnRoughFields) {
   }
 }
 
+// Each case: auto falls back to KSP, -diffusion_solver spectral is a UserError naming it.
 TEST(SpectralDiffusion, FallsBackWhereItDoesNotApply) {
-  OptionList neumann = diffusion_case("12,10", "3,2.5", "1 +- 20%", "auto");
-  neumann.push_back({"grid_bc", "neumann"});
-  auto sim = run(neumann, 1);
-  EXPECT_FALSE(sim->diffusion_solver()->spectral(0));
-  OptionList forced = neumann;
-  forced.back() = {"grid_bc", "neumann"};
-  for (auto& [k, v] : forced)
-    if (k == "diffusion_solver") v = "spectral";
-  try {
-    run(forced, 1);
-    ADD_FAILURE() << "no UserError for -diffusion_solver spectral on a Neumann grid";
-  } catch (const UserError& e) {
-    EXPECT_NE(std::string(e.what()).find("-diffusion_solver spectral"), std::string::npos);
-  }
-  if (comm_size() > 1) { // periodic, but parallel: KSP
-    auto par = run(diffusion_case("12,10", "3,2.5", "1 +- 20%", "auto"), 1);
-    EXPECT_FALSE(par->diffusion_solver()->spectral(0));
+  const std::vector<OptionList> cases = {{{"grid_bc", "dirichlet"}},
+                                         {{"D_a", "0.5 + 0.2*x/3"}},
+                                         {{"grid_bc", "neumann"},
+                                          {"diffusion", "tensor"},
+                                          {"tensor_theta", "0.4"},
+                                          {"tensor_l1", "1.6"}}};
+  for (const OptionList& extra : cases) {
+    SCOPED_TRACE(extra.front().first + " " + extra.front().second);
+    OptionList o = diffusion_case("12,10", "3,2.5", "1 +- 20%", "auto");
+    o.insert(o.end(), extra.begin(), extra.end());
+    auto sim = run(o, 1);
+    EXPECT_FALSE(sim->diffusion_solver()->spectral(0));
+    for (auto& [k, v] : o)
+      if (k == "diffusion_solver") v = "spectral";
+    try {
+      run(o, 1);
+      ADD_FAILURE() << "no UserError for -diffusion_solver spectral";
+    } catch (const UserError& e) {
+      EXPECT_NE(std::string(e.what()).find("-diffusion_solver spectral"), std::string::npos);
+    }
   }
 }
