@@ -78,6 +78,28 @@ std::string check_model(const io::ImageInfo& info, const ModelEntry& model) {
   return {};
 }
 
+// "" if the checkpoint's fluid state fits this run, else why not: a -fluid run needs the
+// fluid's state (a checkpoint without it would silently restart the flow from rest), and a run
+// without -fluid refuses a checkpoint that has one (its flow would silently stop).
+std::string check_fluid(const io::ImageInfo& info, const FluidSolver* fluid) {
+  const std::string* kind = info.attributes.string("fluid");
+  if (!fluid && kind)
+    return "the checkpoint holds the flow of -fluid " + *kind +
+           ", this run has no -fluid (add -fluid " + *kind + " to continue it)";
+  if (!fluid) return {};
+  if (!kind)
+    return "the checkpoint has no fluid state (written without -fluid, or by a morphogen that "
+           "did not checkpoint the flow), this run has -fluid " +
+           fluid->kind_name() + " (restart without -fluid, or start the run afresh)";
+  for (const auto& [name, vec] : fluid->state()) {
+    bool found = false;
+    for (const auto& n : info.arrays)
+      found |= n == name;
+    if (!found) return "the checkpoint of -fluid " + *kind + " has no dataset " + name;
+  }
+  return {};
+}
+
 void bcast_string(MPI_Comm comm, std::string& s) {
   long long n = static_cast<long long>(s.size());
   MPI_Bcast(&n, 1, MPI_LONG_LONG, 0, comm);
@@ -157,6 +179,8 @@ void check_restart_grid(const Simulation& sim, const RestartPoint& rp) {
           (sim.level() > 0 || rp.level > 0 ? " (sequencing level " + std::to_string(rp.level) + ")"
                                            : std::string()));
   }
+  const std::string why = check_fluid(rp.info, sim.fluid());
+  if (!why.empty()) throw UserError("-restart " + rp.path + ": " + why);
 }
 
 void restore(Simulation& sim, const RestartPoint& rp) {
@@ -168,6 +192,19 @@ void restore(Simulation& sim, const RestartPoint& rp) {
   const std::string err = io.read(rp.path, sim.species(), fields);
   throw_if_any(sim.grid().comm(),
                err.empty() ? err : "-restart " + rp.path + ": cannot read the fields: " + err);
+  if (FluidSolver* fluid = sim.fluid()) {
+    std::vector<std::string> names;
+    std::vector<Vec> vecs;
+    for (const auto& [name, vec] : fluid->state()) {
+      names.push_back(name);
+      vecs.push_back(vec);
+    }
+    const std::string ferr = io.read(rp.path, names, vecs);
+    throw_if_any(sim.grid().comm(),
+                 ferr.empty() ? ferr
+                              : "-restart " + rp.path + ": cannot read the fluid state: " + ferr);
+    fluid->state_restored();
+  }
   sim.set_clock(rp.time, static_cast<PetscInt>(rp.step));
   sim.refresh_ghosts();
 }

@@ -36,12 +36,21 @@ std::string library_versions(std::string& hdf5) {
   return v;
 }
 
-// The advection velocity's components as ghosted local Vecs (owned cells set) named
-// velocity_x, velocity_y[, velocity_z], for snapshots of advected runs (ParaView shows the
-// flow beside the pattern); nothing without -advect.
+// The velocity's components as ghosted local Vecs (owned cells set) named velocity_x,
+// velocity_y[, velocity_z], for snapshots (ParaView shows the flow beside the pattern): the
+// advection stage's (-advect), else the fluid's (-fluid without -advect: `fields` gets the
+// fluid's own Vecs); nothing with neither.
 void velocity_fields(const Simulation& sim, std::vector<std::string>& names,
-                     std::vector<VecH>& vecs) {
+                     std::vector<VecH>& vecs, std::vector<Vec>& fields) {
   const AdvectionStage* adv = sim.advection();
+  if (!adv && sim.fluid()) {
+    for (const auto& [name, vec] : sim.fluid()->state())
+      if (name.rfind("velocity_", 0) == 0) {
+        names.push_back(name);
+        fields.push_back(vec);
+      }
+    return;
+  }
   if (!adv) return;
   const Grid& grid = sim.grid();
   const Box& ob = grid.owned();
@@ -58,6 +67,7 @@ void velocity_fields(const Simulation& sim, std::vector<std::string>& names,
           a[grid.local_index(i, j, k)] = v[static_cast<size_t>(grid.owned_index(i, j, k))];
     MG_PETSC(VecRestoreArray(vecs.back(), &a));
     names.push_back(std::string("velocity_") + axis[d]);
+    fields.push_back(vecs.back());
   }
 }
 
@@ -328,9 +338,7 @@ void RunOutput::write_snapshot(Simulation& sim) {
     fields.push_back(v);
   std::vector<std::string> names = sim.species();
   std::vector<VecH> velocity;
-  velocity_fields(sim, names, velocity);
-  for (auto& v : velocity)
-    fields.push_back(v);
+  velocity_fields(sim, names, velocity, fields);
   const std::string err = io_->write(path + ".tmp", names, fields, out.snapshot_single, attrs);
   if (!err.empty()) write_failed("snapshot", path, err);
   std::string index_err;
@@ -376,7 +384,15 @@ void RunOutput::write_checkpoint(Simulation& sim) {
   std::vector<Vec> fields;
   for (auto& v : sim.state())
     fields.push_back(v);
-  const std::string err = io_->write(path + ".tmp", sim.species(), fields, false, attrs);
+  std::vector<std::string> names = sim.species();
+  if (const FluidSolver* fluid = sim.fluid()) { // the flow, for a bitwise restart
+    attrs.strings.emplace_back("fluid", fluid->kind_name());
+    for (const auto& [name, vec] : fluid->state()) {
+      names.push_back(name);
+      fields.push_back(vec);
+    }
+  }
+  const std::string err = io_->write(path + ".tmp", names, fields, false, attrs);
   if (!err.empty()) write_failed("checkpoint", path, err);
   if (rank_ == 0) {
     std::error_code ec;

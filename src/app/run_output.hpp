@@ -1,7 +1,9 @@
 // What a run writes while it steps, and when it stops early:
 //  - VTKHDF snapshots (float32/64) every -snapshot_every steps / -snapshot_every_time, and the
-//    final state, with the <name>.vtkhdf.series and <name>.xmf indexes;
-//  - checkpoints (float64 + /morphogen restart attributes) every -checkpoint_every steps,
+//    final state, with the <name>.vtkhdf.series and <name>.xmf indexes; the species plus
+//    velocity_x, velocity_y[, _z] when the run advects (-advect) or has a fluid (-fluid);
+//  - checkpoints (float64 + /morphogen restart attributes; with -fluid also the fluid's state,
+//    FluidSolver::state(), and the attribute fluid = its kind) every -checkpoint_every steps,
 //    -checkpoint_every_time, -checkpoint_every_walltime minutes, at the end, and when the run
 //    must stop: SIGUSR1/SIGTERM (all ranks agree at the next step) or the -max_walltime budget.
 //    Written to <file>.tmp and renamed when complete; the newest -checkpoint_keep are kept.

@@ -359,7 +359,7 @@ int run(MPI_Comm comm) {
                "1024^2, and the Brusselator deck (issue 13 part 1)");
   const double deck_T = opt.real("bench_brusselator_T", 125.0, 0.0, 1e6,
                                  "simulated time of the Brusselator deck comparison (0: skip)");
-  const double deck_split_dt = opt.real("bench_brusselator_split_dt", 0.1, 1e-6, 100.0,
+  const double deck_split_dt = opt.real("bench_brusselator_split_dt", 0.25, 1e-6, 100.0,
                                         "split step of the Brusselator deck comparison");
   const bool with_scaling = opt.flag(
       "bench_scaling", true,

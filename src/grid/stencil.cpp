@@ -71,4 +71,29 @@ bool to_rows(const Stencil& s, RowStencil& out) {
   return true;
 }
 
+bool box_classes(const RowStencil& rows, BoxClasses& out) {
+  if (rows.nrows != 9 || !rows.box || rows.off[0][0] != 0 || rows.off[0][1] != 0) return false;
+  BoxClasses c;
+  std::array<bool, 4> seen{};
+  int faces = 0, corners = 0, covered = 0; // covered: bit per (dy, dz) of the 3x3 rows
+  for (int r = 0; r < 9; ++r) {
+    const int dy = rows.off[r][0], dz = rows.off[r][1];
+    if (dy < -1 || dy > 1 || dz < -1 || dz > 1) return false;
+    covered |= 1 << (3 * (dz + 1) + dy + 1);
+    const int yz = (dy != 0) + (dz != 0);
+    if (yz == 1 && faces < 4) c.perm[1 + faces++] = r;
+    if (yz == 2 && corners < 4) c.perm[5 + corners++] = r;
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int k = yz + (dx != 0);
+      const double w = rows.w[3 * r + dx + 1];
+      if (seen[k] && w != c.w[k]) return false;
+      seen[k] = true;
+      c.w[k] = w;
+    }
+  }
+  if (covered != 0x1ff || faces != 4 || corners != 4) return false;
+  out = c;
+  return true;
+}
+
 } // namespace morphogen

@@ -49,8 +49,10 @@ void DiffusionSolver::choose_spectral(const std::string& mode) {
   bool user_ksp = false;
   for (const char* name :
        {"-diffusion_ksp_type", "-diffusion_pc_type", "-diffusion_ksp_rtol", "-diffusion_ksp_atol",
-        "-diffusion_ksp_max_it", "-diffusion_sub_pc_type", "-diffusion_ksp_monitor",
-        "-diffusion_ksp_view", "-diffusion_ksp_converged_reason", "-diffusion_ksp_norm_type"}) {
+        "-diffusion_ksp_max_it", "-diffusion_ksp_monitor", "-diffusion_ksp_view",
+        "-diffusion_ksp_converged_reason", "-diffusion_ksp_norm_type"}) {
+    // (not -diffusion_sub_pc_type: ksp_defaults sets it itself for block Jacobi, and a later
+    // Simulation in the same process, a grid level or a sweep point, must not read it as a user's)
     PetscBool set = PETSC_FALSE;
     MG_PETSC(PetscOptionsHasName(nullptr, nullptr, name, &set));
     user_ksp |= set == PETSC_TRUE;
@@ -65,7 +67,7 @@ void DiffusionSolver::choose_spectral(const std::string& mode) {
     else if (!ops_.symmetric(s) || ops_.has_dirichlet())
       why = "Dirichlet data, pinned cells or a non-symmetric operator";
     else
-      spectral_[s] = SpectralDiffusion::create(grid_, ops_.M(s), &why);
+      spectral_[s] = SpectralSolver::create(grid_, ops_.M(s), &why);
     if (!spectral_[s] && mode == "spectral")
       throw UserError("-diffusion_solver spectral: species " + species_[s] + ": " + why +
                       "; allowed here: ksp or auto");
@@ -169,7 +171,7 @@ void DiffusionSolver::solve(int s, Vec u, double dt, double theta, PetscInt step
   }
   const double c = dt * ops_.scale(s);
   if (use_spectral(s)) {
-    spectral_[s]->solve(u, c, theta);
+    spectral_[s]->step(u, c, theta);
     iterations_[s] = 0;
     return;
   }

@@ -17,17 +17,17 @@
 // jacobi or sor for Sanderson's relaxation). A diverged solve is reported with species, KSP reason
 // and iteration count. -diffusion_solver auto|ksp|spectral: a species whose matrix is a
 // constant-coefficient stencil on periodic / zero-flux axes (checked numerically,
-// spectral_diffusion.hpp) is solved exactly by FFT/DCT instead, on any number of ranks (auto:
-// wherever it applies and no -diffusion_ksp_*/-diffusion_pc_* option is given, else KSP; spectral:
-// an error where it does not apply). A species whose matrix is later re-assembled
+// operators/spectral_solver.hpp) is solved exactly by FFT/DCT instead, on any number of ranks
+// (auto: wherever it applies and no -diffusion_ksp_*/-diffusion_pc_* option is given, else KSP;
+// spectral: an error where it does not apply). A species whose matrix is later re-assembled
 // (operator_changed) or modified goes back to KSP. The choice per species is printed at setup.
 #pragma once
 
 #include "core/options.hpp"
 #include "grid/halo.hpp"
 #include "grid/stencil.hpp"
-#include "integrators/spectral_diffusion.hpp"
 #include "operators/operator_matrices.hpp"
+#include "operators/spectral_solver.hpp"
 
 #include <cmath>
 #include <memory>
@@ -55,7 +55,7 @@ public:
   // A_s is rebuilt on the next solve.
   void operator_changed(int s) { assembled_dt_[s] = std::nan(""); }
 
-  // True while species s is solved by FFT (spectral_diffusion.hpp).
+  // True while species s is solved by FFT (operators/spectral_solver.hpp).
   bool spectral(int s) const { return spectral_[s] != nullptr; }
   PetscInt last_iterations(int s) const { return iterations_[s]; }
   PetscInt total_iterations() const { return total_its_; }
@@ -72,8 +72,8 @@ private:
   std::vector<std::string> species_;
   std::vector<KSPH> ksp_; // (PETSc reference-counts the operators they hold)
   std::vector<MatH> A_;
-  std::vector<std::unique_ptr<SpectralDiffusion>> spectral_; // null: KSP
-  std::vector<Mat> spectral_mat_;                            // the M_s it was checked on
+  std::vector<std::unique_ptr<SpectralSolver>> spectral_; // null: KSP
+  std::vector<Mat> spectral_mat_;                         // the M_s it was checked on
   std::vector<double> assembled_dt_, assembled_theta_;
   std::vector<PetscInt> iterations_;
   PetscInt total_its_ = 0;

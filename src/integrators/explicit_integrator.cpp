@@ -16,6 +16,7 @@ ExplicitIntegrator::ExplicitIntegrator(const Grid& grid, const Halo& halo, RowFn
     : grid_(grid), halo_(halo), row_fn_(row_fn), ns_(nspecies), stencil_(stencil), D_(std::move(D)),
       floor_(std::move(floor)), params_(params), dirichlet_(dirichlet) {
   to_rows(stencil_, rows_);
+  by_class_ = box_classes(rows_, classes_); // 19pt, 27pt: weight classes, rows in class order
   if (params_.any_field())
     params_.expand_scalars(static_cast<size_t>(grid.owned().m[0]), const_rows_);
 }
@@ -197,8 +198,10 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>& work, do
   const Box& ob = grid_.owned();
   const PetscInt gx = grid_.ghosted().m[0], gxy = gx * grid_.ghosted().m[1];
   std::vector<PetscInt> delta(nr);
-  for (int r = 0; r < nr; ++r)
-    delta[r] = gx * rows_.off[r][0] + gxy * rows_.off[r][1];
+  for (int r = 0; r < nr; ++r) {
+    const int q = by_class_ ? classes_.perm[r] : r;
+    delta[r] = gx * rows_.off[q][0] + gxy * rows_.off[q][1];
+  }
   std::vector<const double*> src(static_cast<size_t>(ns_ * nr));
   std::vector<double*> dst(ns_);
   std::vector<const double*> prow(np, nullptr);
@@ -212,6 +215,7 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>& work, do
   row.pconst = params_.scalar.data();
   row.dt = dt;
   row.dst = dst.data();
+  row.wclass = by_class_ ? classes_.w.data() : nullptr;
   // In 3-D, sweep the box in blocks of y rows so that the three z planes a row reads stay in
   // the per-core L2 cache (about 256 KiB of state per block); in 2-D one block is the box.
   PetscInt jblock = ob.m[1];

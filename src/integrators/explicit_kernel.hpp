@@ -14,6 +14,10 @@
 // (configure with -DMORPHOGEN_VEC_REPORT=ON to see "loop vectorized" for this file).
 // (`omp simd` is not used: GCC 12 turns the small per-cell arrays into "simd arrays" and then
 // refuses to vectorise.)
+// The 3-D box stencils (19pt, 27pt: 9 rows) take the weight-class path
+// explicit_row_box_classes when ExplicitRow::wclass is set (the fused driver sets it; a
+// different summation order, stated there); the 27-tap loop serves a 9-row stencil without
+// that form (slowly: GCC does not unroll its loop over 9 rows, so it does not vectorise it).
 #pragma once
 
 #include "fields/clamp_kernel.hpp"
@@ -31,10 +35,114 @@ struct ExplicitRow {
   double dt = 0;
   double* const* dst = nullptr;       // [nspecies] output rows
   const double* const* div = nullptr; // [nspecies] precomputed diffusion rows (general path)
+  // 9-row box stencils only: the weights by class (grid/stencil.hpp, BoxClasses: centre, face,
+  // edge, corner) with src in class order, or null for the general 27-tap form of w.
+  const double* wclass = nullptr;
 };
+
+// The two x-profiles of explicit_row_box_classes for x = x0 .. x0 + len - 1 of one species'
+// 9 rows in class order (w: centre, face, edge, corner weight), A being the centre row:
+//   B = (f1 + f2) + (f3 + f4)        (the 4 face rows)
+//   C = (k1 + k2) + (k3 + k4)        (the 4 corner rows)
+//   q(x) = (w_c A + w_f B) + w_e C   (the taps at dx = 0)
+//   p(x) = (w_f A + w_e B) + w_k C   (the taps at dx = -1, +1; w_k C left out if !Corners)
+template <bool Corners>
+inline void box_row_profiles(const double* const* rows, const double* w, int x0, int len,
+                             double* __restrict__ p, double* __restrict__ q) {
+  const double* __restrict__ c0 = rows[0] + x0;
+  const double* __restrict__ f1 = rows[1] + x0;
+  const double* __restrict__ f2 = rows[2] + x0;
+  const double* __restrict__ f3 = rows[3] + x0;
+  const double* __restrict__ f4 = rows[4] + x0;
+  const double* __restrict__ k1 = rows[5] + x0;
+  const double* __restrict__ k2 = rows[6] + x0;
+  const double* __restrict__ k3 = rows[7] + x0;
+  const double* __restrict__ k4 = rows[8] + x0;
+  const double wc = w[0], wf = w[1], we = w[2], wk = w[3];
+#pragma GCC ivdep
+  for (int x = 0; x < len; ++x) {
+    const double A = c0[x];
+    const double B = (f1[x] + f2[x]) + (f3[x] + f4[x]);
+    const double C = (k1[x] + k2[x]) + (k3[x] + k4[x]);
+    q[x] = (wc * A + wf * B) + we * C;
+    if constexpr (Corners)
+      p[x] = (wf * A + we * B) + wk * C;
+    else
+      p[x] = wf * A + we * B;
+  }
+}
+
+// The 9-row box stencils by weight class (19pt, 27pt; ExplicitRow::wclass set), rows in class
+// order: src[s*9] the centre row, src[s*9 + 1..4] the face rows, src[s*9 + 5..8] the corner
+// rows. Per chunk of up to kBoxChunk cells, first the profiles p and q of box_row_profiles at
+// x = i-1 .. i+1 into stack buffers, then per cell
+//   lap = q(i) + (p(i-1) + p(i+1))
+// and the update of explicit_row. Per cell and species: 9 loads, 6 adds and 4-6 multiply-adds
+// for the profiles, 3 loads and 2 adds for lap, instead of 27 loads and 27 multiply-adds.
+// Each value is one fixed expression of the cell's neighbours, so neither the chunks nor the
+// rank decomposition change a bit.
+constexpr int kBoxChunk = 128;
+
+template <class M, bool FieldParams, bool Corners>
+inline void explicit_row_box_classes(const ExplicitRow& a) {
+  constexpr int NS = M::nspecies;
+  constexpr int NP = M::nparams;
+  const double* __restrict__ src[NS];
+  double* __restrict__ dst[NS];
+  double D[NS], floor[NS], pc[NP > 0 ? NP : 1];
+  const double* __restrict__ prow[NP > 0 ? NP : 1];
+  for (int s = 0; s < NS; ++s) {
+    src[s] = a.src[s * 9];
+    dst[s] = a.dst[s];
+    D[s] = a.D[s];
+    floor[s] = a.floor[s];
+  }
+  for (int q = 0; q < NP; ++q) {
+    if constexpr (FieldParams)
+      prow[q] = a.prow[q];
+    else
+      pc[q] = a.pconst[q];
+  }
+  const double dt = a.dt;
+  const int n = a.n;
+  double pbuf[NS][kBoxChunk + 2], qbuf[NS][kBoxChunk + 2]; // at x = i0 - 1 .. i0 + m
+  for (int i0 = 0; i0 < n; i0 += kBoxChunk) {
+    const int m = n - i0 < kBoxChunk ? n - i0 : kBoxChunk;
+    for (int s = 0; s < NS; ++s)
+      box_row_profiles<Corners>(a.src + s * 9, a.wclass, i0 - 1, m + 2, pbuf[s], qbuf[s]);
+#pragma GCC ivdep
+    for (int x = 0; x < m; ++x) {
+      const int i = i0 + x;
+      double u[NS], r[NS], p[NP > 0 ? NP : 1];
+      for (int q = 0; q < NP; ++q) {
+        if constexpr (FieldParams)
+          p[q] = prow[q][i];
+        else
+          p[q] = pc[q];
+      }
+      for (int s = 0; s < NS; ++s)
+        u[s] = src[s][i];
+      M::rates(u, p, r);
+      for (int s = 0; s < NS; ++s) {
+        const double lap = qbuf[s][x + 1] + (pbuf[s][x] + pbuf[s][x + 2]);
+        const double v = u[s] + dt * (D[s] * lap + r[s]);
+        dst[s][i] = clamp_to_floor(v, floor[s]);
+      }
+    }
+  }
+}
 
 template <class M, int NR, bool Box, bool FieldParams>
 inline void explicit_row(const ExplicitRow& a) {
+  if constexpr (NR == 9 && Box) {
+    if (a.wclass) {
+      if (a.wclass[3] != 0.0)
+        explicit_row_box_classes<M, FieldParams, true>(a);
+      else
+        explicit_row_box_classes<M, FieldParams, false>(a);
+      return;
+    }
+  }
   constexpr int NS = M::nspecies;
   constexpr int NP = M::nparams;
   const double* __restrict__ src[NS * NR];

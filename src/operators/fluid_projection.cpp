@@ -54,6 +54,23 @@ void FluidSolver::assemble_poisson() {
     MG_PETSC(MatSetNullSpace(A_pois_, null_));
   }
   MG_PETSC(KSPSetOperators(ksp_pois_, A_pois_, A_pois_));
+  choose_pressure_solver();
+}
+
+// A = -(D G) is diagonal in the DFT/DCT basis of the grid's axes when nothing breaks the
+// translation invariance (an obstacle, an outflow face): checked numerically on -A.
+void FluidSolver::choose_pressure_solver() {
+  for (const char* name : {"-fluid_ksp_type", "-fluid_pc_type", "-fluid_ksp_rtol",
+                           "-fluid_ksp_atol", "-fluid_ksp_max_it", "-fluid_ksp_monitor"}) {
+    PetscBool set = PETSC_FALSE;
+    MG_PETSC(PetscOptionsHasName(nullptr, nullptr, name, &set));
+    if (set) return; // a user tuning the KSP gets the KSP
+  }
+  MatH neg;
+  MG_PETSC(MatDuplicate(A_pois_, MAT_COPY_VALUES, neg.out()));
+  MG_PETSC(MatScale(neg, -1.0));
+  std::string why;
+  spectral_pois_ = SpectralSolver::create(grid_, neg, &why);
 }
 
 // rhs = -div(u_f) at the fluid cells (0 at solid cells); returns sum of div^2 over this rank.
@@ -82,6 +99,18 @@ double divergence_rhs(const Grid& grid, const double* const u[2], double* rhs,
 }
 } // namespace
 
+void FluidSolver::solve_pressure_ksp() {
+  MG_PETSC(KSPSolve(ksp_pois_, rhs_, p_));
+  KSPConvergedReason reason;
+  MG_PETSC(KSPGetConvergedReason(ksp_pois_, &reason));
+  MG_PETSC(KSPGetIterationNumber(ksp_pois_, &poisson_its_));
+  total_poisson_its_ += poisson_its_;
+  if (reason < 0)
+    throw UserError(set_.option_text + ": the pressure solve diverged (KSP reason " +
+                    KSPConvergedReasons[reason] + " after " + std::to_string(poisson_its_) +
+                    " iterations); try other -fluid_ksp_type / -fluid_pc_type");
+}
+
 void FluidSolver::project() {
   refresh(u_[0]);
   refresh(u_[1]);
@@ -95,15 +124,12 @@ void FluidSolver::project() {
   double before = divergence_rhs(grid_, u, r, facefn, solidfn);
   MG_PETSC(VecRestoreArray(rhs_, &r));
   if (null_) MG_PETSC(MatNullSpaceRemove(null_, rhs_));
-  MG_PETSC(KSPSolve(ksp_pois_, rhs_, p_));
-  KSPConvergedReason reason;
-  MG_PETSC(KSPGetConvergedReason(ksp_pois_, &reason));
-  MG_PETSC(KSPGetIterationNumber(ksp_pois_, &poisson_its_));
-  total_poisson_its_ += poisson_its_;
-  if (reason < 0)
-    throw UserError(set_.option_text + ": the pressure solve diverged (KSP reason " +
-                    KSPConvergedReasons[reason] + " after " + std::to_string(poisson_its_) +
-                    " iterations); try other -fluid_ksp_type / -fluid_pc_type");
+  if (spectral_pois_) {
+    spectral_pois_->solve_negated(rhs_, p_);
+    poisson_its_ = 0;
+  } else {
+    solve_pressure_ksp();
+  }
   copy_owned(p_local_, p_, true);
   refresh(p_local_);
   const PetscScalar* p;

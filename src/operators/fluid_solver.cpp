@@ -13,7 +13,7 @@ namespace morphogen {
 
 namespace {
 
-const char* kind_name(fluid::Kind k) {
+const char* kind_text(fluid::Kind k) {
   return k == fluid::Kind::Cavity ? "cavity" : (k == fluid::Kind::Channel ? "channel" : "periodic");
 }
 
@@ -209,6 +209,21 @@ double FluidSolver::speed_bound() const {
   return 2.0 * std::max(m, wall); // flows around obstacles speed up; the stage checks each step
 }
 
+std::string FluidSolver::kind_name() const {
+  return kind_text(set_.kind);
+}
+
+std::vector<std::pair<std::string, Vec>> FluidSolver::state() const {
+  return {{"velocity_x", u_[0]}, {"velocity_y", u_[1]}, {"fluid_pressure", p_local_}};
+}
+
+void FluidSolver::state_restored() {
+  for (auto& u : u_)
+    refresh(u);
+  copy_owned(p_local_, p_, false); // the next pressure solve starts from the restored p
+  refresh(p_local_);
+}
+
 std::string FluidSolver::describe() const {
   std::string b = set_.kind == fluid::Kind::Cavity
                       ? "lid speed " + format_number(set_.lid)
@@ -220,10 +235,11 @@ std::string FluidSolver::describe() const {
   MG_PETSC(KSPGetType(ksp_pois_, &kt));
   MG_PETSC(KSPGetPC(ksp_pois_, &pc));
   MG_PETSC(PCGetType(pc, &pt));
-  return std::string("stable fluids: ") + kind_name(set_.kind) + " (" + b + "), viscosity " +
+  return std::string("stable fluids: ") + kind_text(set_.kind) + " (" + b + "), viscosity " +
          format_number(set_.viscosity) + ", " + std::to_string(set_.substeps) +
          " substep(s) per step, " + (set_.interp == advect::Interp::Cubic ? "cubic" : "linear") +
-         " self-advection, pressure solve " + kt + "/" + pt;
+         " self-advection, pressure solve " +
+         (spectral_pois_ ? std::string("spectral (FFT/DCT, exact)") : std::string(kt) + "/" + pt);
 }
 
 } // namespace morphogen

@@ -22,8 +22,12 @@
 #include "operators/fluid_kernel.hpp"
 #include "operators/velocity_source.hpp"
 
+#include "operators/spectral_solver.hpp"
+
 #include <functional>
 #include <memory>
+#include <string>
+#include <utility>
 #include <vector>
 
 namespace morphogen {
@@ -61,6 +65,16 @@ public:
   bool solid(PetscInt i, PetscInt j) const;
 
   Vec component(int d) const override { return u_[d]; }
+  // True when the pressure is solved exactly by FFT/DCT (operators/spectral_solver.hpp).
+  bool spectral_pressure() const { return spectral_pois_ != nullptr; }
+  // "cavity", "channel" or "periodic".
+  std::string kind_name() const;
+  // The state a restart needs for a bitwise continuation, as ghosted local Vecs (owned cells
+  // current): velocity_x, velocity_y and fluid_pressure (the last projection's pressure, the
+  // initial guess of the next pressure solve). Written into checkpoints; after a restart has
+  // overwritten their owned cells, call state_restored(). Collective.
+  std::vector<std::pair<std::string, Vec>> state() const;
+  void state_restored();
   double speed_bound() const override;
   std::string option_text() const override { return set_.option_text; }
   std::string describe() const override;
@@ -94,6 +108,11 @@ private:
   MatNullSpace null_ = nullptr; // constants on the fluid cells (closed domains)
   double div_ratio_ = 0.0;
   PetscInt poisson_its_ = 0, total_poisson_its_ = 0;
+  // The pressure solve by FFT/DCT where A is a constant stencil (no obstacle, no outflow face)
+  // and no -fluid_ksp_*/-fluid_pc_* option is given; else null (KSP).
+  std::unique_ptr<SpectralSolver> spectral_pois_;
+  void choose_pressure_solver();
+  void solve_pressure_ksp();
 };
 
 } // namespace morphogen

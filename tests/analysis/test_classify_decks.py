@@ -5,7 +5,8 @@ Figs. 1 and 3, Garrity's four Gray-Scott presets, Pearson's spots, a Barkley spi
 Brusselator's hexagons, its stripes from fixed rows (Fig. 20, pinned cells) and two coupled
 Brusselator layers' spots on spots (Fig. 10), and Witkin & Kass's Fig. 3 buttons (the mazes,
 sand and the orientation-map buttons also by their local stripe direction against the deck's
-map) (the diffusion-tensor decks: test_classify_tensor_decks.py). Classes of
+map), and the stable-ARD paper's Fig. 1 Barkley column (turbulence in a channel flow past two
+balls) (the diffusion-tensor decks: test_classify_tensor_decks.py). Classes of
 spots refer to the species: Turing's spots are high in b, so the same run is `holes` in a."""
 import json
 import math
@@ -47,6 +48,7 @@ EXPECTED = {
     "witkin_kass_zebra_haunch": {"p1": "labyrinth", "m1": "labyrinth"},  # WK Fig. 3-3c: curved stripes
     "witkin_kass_giraffe": {"cp": "holes", "cm": "holes"},  # WK Fig. 3-1b: polygons in a network
     "witkin_kass_reptile": {"cp": "holes", "cm": "holes"},  # WK Fig. 3-1a: finer scales
+    "fig1_barkley": {"A": "chaotic"},  # stable-ARD Fig. 1: Barkley turbulence in the channel flow
 }
 
 

@@ -162,3 +162,55 @@ TEST(Stencil, ThreeDBoxStencilsIsotropicSecondOrder) {
     EXPECT_FALSE(make_stencil(name, 2, h, s));
   }
 }
+
+// The weight-class form of the 3-D box stencils (the explicit kernel's fast path): class
+// weights equal to the published ones (Patra & Karttunen: 19pt {-24, 2, 1, 0} / 6h^2, 27pt
+// {-128, 14, 3, 1} / 30h^2), perm listing the centre, the 4 face rows and the 4 corner rows,
+// and a stencil whose taps differ within a class (or that is not a 9-row box) refused.
+TEST(Stencil, BoxClassesOfTheIsotropicBoxStencils) {
+  const double h[3] = {0.5, 0.5, 0.5};
+  const double s2 = 1.0 / (h[0] * h[0]);
+  for (const char* name : {"19pt", "27pt"}) {
+    const bool full = std::string(name) == "27pt";
+    const double expect[4] = {full ? -128.0 / 30 : -24.0 / 6, full ? 14.0 / 30 : 2.0 / 6,
+                              full ? 3.0 / 30 : 1.0 / 6, full ? 1.0 / 30 : 0.0};
+    Stencil s;
+    ASSERT_TRUE(make_stencil(name, 3, h, s));
+    RowStencil r;
+    ASSERT_TRUE(to_rows(s, r));
+    BoxClasses c;
+    ASSERT_TRUE(box_classes(r, c)) << name;
+    for (int k = 0; k < 4; ++k)
+      EXPECT_NEAR(c.w[k], expect[k] * s2, 1e-12 * s2) << name << " class " << k;
+    EXPECT_EQ(c.perm[0], 0);
+    int seen = 0;
+    for (int q = 0; q < 9; ++q) {
+      const int yz = (r.off[c.perm[q]][0] != 0) + (r.off[c.perm[q]][1] != 0);
+      EXPECT_EQ(yz, q == 0 ? 0 : q < 5 ? 1 : 2) << name << " position " << q;
+      seen |= 1 << c.perm[q];
+    }
+    EXPECT_EQ(seen, 0x1ff) << "perm is a permutation of the 9 rows";
+    // The class form reproduces every tap of the row form.
+    for (int q = 0; q < 9; ++q)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int k = (r.off[q][0] != 0) + (r.off[q][1] != 0) + (dx != 0);
+        EXPECT_EQ(r.w[3 * q + dx + 1], c.w[k]) << name;
+      }
+    // One edge tap changed: no longer one weight per class.
+    RowStencil bad = r;
+    bad.w[3 * c.perm[1]] *= 1.5;
+    EXPECT_FALSE(box_classes(bad, c));
+    RowStencil dup = r; // a row repeated (the 3x3 rows not all present)
+    dup.off[8] = dup.off[7];
+    EXPECT_FALSE(box_classes(dup, c));
+  }
+  Stencil s7, s9;
+  RowStencil r7, r9;
+  BoxClasses c;
+  ASSERT_TRUE(make_stencil("7pt", 3, h, s7));
+  ASSERT_TRUE(make_stencil("9pt", 2, h, s9));
+  ASSERT_TRUE(to_rows(s7, r7));
+  ASSERT_TRUE(to_rows(s9, r9));
+  EXPECT_FALSE(box_classes(r7, c));
+  EXPECT_FALSE(box_classes(r9, c));
+}

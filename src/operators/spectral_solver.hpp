@@ -1,5 +1,6 @@
-// Exact solve of one implicit diffusion substep by a separable transform (spectral_transform.hpp:
-// DFT on periodic axes, DCT-II on zero-flux axes; any number of ranks):
+// Exact solves with a constant-coefficient stencil matrix M by a separable transform
+// (grid/spectral_transform.hpp: DFT on periodic axes, DCT-II / DST-II on even / odd axes; any
+// number of ranks). One implicit diffusion substep (step()):
 //
 //   (I - theta c M) u_new = (I + (1 - theta) c M) u,    c = dt scale_s,
 //
@@ -15,10 +16,11 @@
 // product for a non-trivial x to 1e-10 relative (this rejects pinned cells, spatially varying
 // coefficients, cross terms on zero-flux axes and any stencil that is not diagonal), lambda_k must
 // be real and <= 0 (a dissipative symmetric operator). create() returns null and says why
-// otherwise; the caller then uses KSP.
+// otherwise; the caller then uses KSP. solve_negated() solves (-M) x = r (a Poisson or a shifted
+// system given as its negation), with the null modes (lambda = 0) of x set to zero.
 #pragma once
 
-#include "integrators/spectral_transform.hpp"
+#include "grid/spectral_transform.hpp"
 
 #include <memory>
 #include <petscmat.h>
@@ -27,19 +29,24 @@
 
 namespace morphogen {
 
-class SpectralDiffusion {
+class SpectralSolver {
 public:
-  // Null (and *why set) when M is not diagonalised by the transform on this grid.
-  static std::unique_ptr<SpectralDiffusion> create(const Grid& grid, Mat M, std::string* why);
-  ~SpectralDiffusion();
-  SpectralDiffusion(const SpectralDiffusion&) = delete;
-  SpectralDiffusion& operator=(const SpectralDiffusion&) = delete;
+  // Null (and *why set) when M is not diagonalised by the transform on this grid with these
+  // axis kinds (default: the grid's boundaries, axis_kinds()).
+  static std::unique_ptr<SpectralSolver> create(const Grid& grid, Mat M, std::string* why);
+  static std::unique_ptr<SpectralSolver> create(const Grid& grid, Mat M, std::string* why,
+                                                const std::array<AxisKind, 3>& kinds);
+  ~SpectralSolver();
+  SpectralSolver(const SpectralSolver&) = delete;
+  SpectralSolver& operator=(const SpectralSolver&) = delete;
 
   // u <- (I - theta c M)^-1 (I + (1 - theta) c M) u, in place on a global Vec.
-  void solve(Vec u, double c, double theta);
+  void step(Vec u, double c, double theta);
+  // x = (-M)^+ r: the solution of -M x = r without null modes (r must be orthogonal to them).
+  void solve_negated(Vec r, Vec x);
 
 private:
-  explicit SpectralDiffusion(std::unique_ptr<SpectralTransform> t);
+  explicit SpectralSolver(std::unique_ptr<SpectralTransform> t);
   bool measure_symbol(const Grid& grid, Mat M, std::string* why);
   bool check_product(const Grid& grid, Mat M, std::string* why);
   std::unique_ptr<SpectralTransform> t_;

@@ -1,4 +1,4 @@
-#include "integrators/spectral_transform.hpp"
+#include "grid/spectral_transform.hpp"
 
 #include <algorithm>
 #include <fftw3.h>
@@ -27,7 +27,17 @@ void run(fftw_plan p) {
 
 } // namespace
 
-SpectralTransform::SpectralTransform(const Grid& grid) : plans_(std::make_unique<Plans>()) {
+std::array<AxisKind, 3> axis_kinds(const Grid& grid) {
+  std::array<AxisKind, 3> k{};
+  for (int d = 0; d < 3; ++d)
+    k[d] = grid.spec().bc[d] == Boundary::Periodic  ? AxisKind::Periodic
+           : grid.spec().bc[d] == Boundary::Neumann ? AxisKind::Even
+                                                    : AxisKind::Odd;
+  return k;
+}
+
+SpectralTransform::SpectralTransform(const Grid& grid, const std::array<AxisKind, 3>& kinds)
+    : plans_(std::make_unique<Plans>()) {
   int rank = 0;
   MPI_Comm_size(grid.comm(), &size_);
   MPI_Comm_rank(grid.comm(), &rank);
@@ -35,8 +45,8 @@ SpectralTransform::SpectralTransform(const Grid& grid) : plans_(std::make_unique
   const int dim = grid.dim();
   bool all_periodic = true;
   for (int d = 0; d < dim; ++d) {
-    all_periodic &= g.bc[d] == Boundary::Periodic;
-    norm_ *= static_cast<double>(g.bc[d] == Boundary::Periodic ? g.n[d] : 2 * g.n[d]);
+    all_periodic &= kinds[d] == AxisKind::Periodic;
+    norm_ *= static_cast<double>(kinds[d] == AxisKind::Periodic ? g.n[d] : 2 * g.n[d]);
   }
   w_ = all_periodic ? 2 : 1;
   S_ = g.n[dim - 1];
@@ -50,7 +60,7 @@ SpectralTransform::SpectralTransform(const Grid& grid) : plans_(std::make_unique
   realA_ = fftw_alloc_real(std::max<size_t>(1, nA * ncols_));
   specA_ = fftw_alloc_real(std::max<size_t>(1, nA * ncolsS_ * w_));
   specB_ = size_ == 1 ? specA_ : fftw_alloc_real(std::max<size_t>(1, entries() * w_));
-  plan(grid);
+  plan(grid, kinds);
   if (size_ > 1) make_scatters(grid);
 }
 
@@ -65,7 +75,7 @@ SpectralTransform::~SpectralTransform() {
 }
 
 // T_rest over this rank's planes of layout A; T_slow along the strided columns of layout B.
-void SpectralTransform::plan(const Grid& grid) {
+void SpectralTransform::plan(const Grid& grid, const std::array<AxisKind, 3>& kinds) {
   const GridSpec& g = grid.spec();
   const int dim = grid.dim(), nrest = dim - 1;
   int rest[2];
@@ -73,9 +83,9 @@ void SpectralTransform::plan(const Grid& grid) {
   for (int r = 0; r < nrest; ++r) // C order: slowest of the rest first
     rest[r] = static_cast<int>(g.n[nrest - 1 - r]);
   for (int r = 0; r < dim; ++r) { // kinds in C order (slow axis first)
-    const bool periodic = g.bc[dim - 1 - r] == Boundary::Periodic;
-    kf[r] = periodic ? FFTW_R2HC : FFTW_REDFT10;
-    kb[r] = periodic ? FFTW_HC2R : FFTW_REDFT01;
+    const AxisKind k = kinds[dim - 1 - r];
+    kf[r] = k == AxisKind::Periodic ? FFTW_R2HC : k == AxisKind::Even ? FFTW_REDFT10 : FFTW_RODFT10;
+    kb[r] = k == AxisKind::Periodic ? FFTW_HC2R : k == AxisKind::Even ? FFTW_REDFT01 : FFTW_RODFT01;
   }
   const int howA = static_cast<int>(a1_ - a0_), nb = static_cast<int>(nb_);
   const int S = static_cast<int>(S_), nc = static_cast<int>(ncols_),

@@ -1,4 +1,4 @@
-#include "integrators/spectral_diffusion.hpp"
+#include "operators/spectral_solver.hpp"
 
 #include "core/petsc_handle.hpp"
 
@@ -31,24 +31,23 @@ double max_all(MPI_Comm comm, double v) {
 
 } // namespace
 
-SpectralDiffusion::SpectralDiffusion(std::unique_ptr<SpectralTransform> t) : t_(std::move(t)) {}
-SpectralDiffusion::~SpectralDiffusion() = default;
+SpectralSolver::SpectralSolver(std::unique_ptr<SpectralTransform> t) : t_(std::move(t)) {}
+SpectralSolver::~SpectralSolver() = default;
 
-std::unique_ptr<SpectralDiffusion> SpectralDiffusion::create(const Grid& grid, Mat M,
-                                                             std::string* why) {
-  for (int d = 0; d < grid.dim(); ++d)
-    if (grid.spec().bc[d] == Boundary::Dirichlet) {
-      *why = "a Dirichlet axis";
-      return nullptr;
-    }
-  std::unique_ptr<SpectralDiffusion> sp(
-      new SpectralDiffusion(std::make_unique<SpectralTransform>(grid)));
+std::unique_ptr<SpectralSolver> SpectralSolver::create(const Grid& grid, Mat M, std::string* why) {
+  return create(grid, M, why, axis_kinds(grid));
+}
+
+std::unique_ptr<SpectralSolver> SpectralSolver::create(const Grid& grid, Mat M, std::string* why,
+                                                       const std::array<AxisKind, 3>& kinds) {
+  std::unique_ptr<SpectralSolver> sp(
+      new SpectralSolver(std::make_unique<SpectralTransform>(grid, kinds)));
   if (!sp->measure_symbol(grid, M, why) || !sp->check_product(grid, M, why)) return nullptr;
   return sp;
 }
 
 // lambda = T(M v) / T(v), v = T^-1(1); real and <= 0 (to 1e-12 of max |lambda|) or refused.
-bool SpectralDiffusion::measure_symbol(const Grid& grid, Mat M, std::string* why) {
+bool SpectralSolver::measure_symbol(const Grid& grid, Mat M, std::string* why) {
   SpectralTransform& t = *t_;
   const size_t n = t.entries(), w = static_cast<size_t>(t.width());
   double* sp = t.spectrum();
@@ -84,7 +83,7 @@ bool SpectralDiffusion::measure_symbol(const Grid& grid, Mat M, std::string* why
 }
 
 // M x against T^-1(lambda T(x)) / norm for a probe x, to 1e-10 of max |lambda|.
-bool SpectralDiffusion::check_product(const Grid& grid, Mat M, std::string* why) {
+bool SpectralSolver::check_product(const Grid& grid, Mat M, std::string* why) {
   SpectralTransform& t = *t_;
   VecH x = grid.create_global(), y = grid.create_global(), z = grid.create_global();
   fill_probe(grid, x);
@@ -108,7 +107,21 @@ bool SpectralDiffusion::check_product(const Grid& grid, Mat M, std::string* why)
   return true;
 }
 
-void SpectralDiffusion::solve(Vec u, double c, double theta) {
+void SpectralSolver::solve_negated(Vec r, Vec x) {
+  SpectralTransform& t = *t_;
+  const size_t n = t.entries(), w = static_cast<size_t>(t.width());
+  t.forward(r);
+  double* sp = t.spectrum();
+  const double tiny = 1e-12 * lmax_, inv_n = 1.0 / t.norm();
+  for (size_t e = 0; e < n; ++e) {
+    const double g = -lambda_[e] > tiny ? -inv_n / lambda_[e] : 0.0;
+    for (size_t k = 0; k < w; ++k)
+      sp[e * w + k] *= g;
+  }
+  t.backward(x);
+}
+
+void SpectralSolver::step(Vec u, double c, double theta) {
   SpectralTransform& t = *t_;
   const size_t n = t.entries(), w = static_cast<size_t>(t.width());
   if (c != gain_c_ || theta != gain_theta_) {
