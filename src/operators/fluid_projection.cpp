@@ -57,20 +57,32 @@ void FluidSolver::assemble_poisson() {
   choose_pressure_solver();
 }
 
-// A = -(D G) is diagonal in the DFT/DCT basis of the grid's axes when nothing breaks the
-// translation invariance (an obstacle, an outflow face): checked numerically on -A.
 void FluidSolver::choose_pressure_solver() {
-  for (const char* name : {"-fluid_ksp_type", "-fluid_pc_type", "-fluid_ksp_rtol",
-                           "-fluid_ksp_atol", "-fluid_ksp_max_it", "-fluid_ksp_monitor"}) {
+  spectral_pois_ = spectral_for(A_pois_, "-fluid_");
+}
+
+// An exact FFT/DCT/DST solver of A x = r where A (the pressure or a viscosity matrix) is diagonal
+// in the transform of the grid's axes with even (mirror) or odd (wall value) rules at
+// non-periodic faces, i.e. nothing breaks the translation invariance (an obstacle, an inflow or
+// outflow face): checked numerically on -A. Null (KSP) otherwise, or when the user set one of
+// the KSP's options (prefix: "-fluid_" or "-fluid_visc_").
+std::unique_ptr<SpectralSolver> FluidSolver::spectral_for(Mat A, const std::string& prefix) {
+  for (const char* opt :
+       {"ksp_type", "pc_type", "ksp_rtol", "ksp_atol", "ksp_max_it", "ksp_monitor"}) {
     PetscBool set = PETSC_FALSE;
-    MG_PETSC(PetscOptionsHasName(nullptr, nullptr, name, &set));
-    if (set) return; // a user tuning the KSP gets the KSP
+    MG_PETSC(PetscOptionsHasName(nullptr, nullptr, (prefix + opt).c_str(), &set));
+    if (set) return nullptr; // a user tuning the KSP gets the KSP
   }
   MatH neg;
-  MG_PETSC(MatDuplicate(A_pois_, MAT_COPY_VALUES, neg.out()));
+  MG_PETSC(MatDuplicate(A, MAT_COPY_VALUES, neg.out()));
   MG_PETSC(MatScale(neg, -1.0));
+  std::array<AxisKind, 3> odd = axis_kinds(grid_);
+  for (AxisKind& k : odd)
+    if (k != AxisKind::Periodic) k = AxisKind::Odd;
   std::string why;
-  spectral_pois_ = SpectralSolver::create(grid_, neg, &why);
+  for (const auto& kinds : {axis_kinds(grid_), odd})
+    if (auto sp = SpectralSolver::create(grid_, neg, &why, kinds)) return sp;
+  return nullptr;
 }
 
 // rhs = -div(u_f) at the fluid cells (0 at solid cells); returns sum of div^2 over this rank.

@@ -65,8 +65,10 @@ public:
   bool solid(PetscInt i, PetscInt j) const;
 
   Vec component(int d) const override { return u_[d]; }
-  // True when the pressure is solved exactly by FFT/DCT (operators/spectral_solver.hpp).
+  // True when the pressure / the viscosity is solved exactly by FFT/DCT/DST
+  // (operators/spectral_solver.hpp).
   bool spectral_pressure() const { return spectral_pois_ != nullptr; }
+  bool spectral_viscosity() const { return spectral_visc_[0] && spectral_visc_[1]; }
   // "cavity", "channel" or "periodic".
   std::string kind_name() const;
   // The state a restart needs for a bitwise continuation, as ghosted local Vecs (owned cells
@@ -110,8 +112,9 @@ private:
   PetscInt poisson_its_ = 0, total_poisson_its_ = 0;
   // The pressure solve by FFT/DCT where A is a constant stencil (no obstacle, no outflow face)
   // and no -fluid_ksp_*/-fluid_pc_* option is given; else null (KSP).
-  std::unique_ptr<SpectralSolver> spectral_pois_;
+  std::unique_ptr<SpectralSolver> spectral_pois_, spectral_visc_[2];
   void choose_pressure_solver();
+  std::unique_ptr<SpectralSolver> spectral_for(Mat A, const std::string& prefix);
   void solve_pressure_ksp();
 };
 

@@ -99,7 +99,11 @@ void FluidSolver::assemble_viscous(double h) {
     MG_PETSC(MatAssemblyBegin(A_visc_[q], MAT_FINAL_ASSEMBLY));
     MG_PETSC(MatAssemblyEnd(A_visc_[q], MAT_FINAL_ASSEMBLY));
     MG_PETSC(KSPSetOperators(ksp_visc_[q], A_visc_[q], A_visc_[q]));
+    spectral_visc_[q] = spectral_for(A_visc_[q], "-fluid_visc_");
   }
+  if (visc_h_ < 0)
+    PetscPrintf(grid_.comm(), "  fluid viscosity solve: %s\n",
+                spectral_viscosity() ? "spectral (FFT/DCT/DST, exact)" : "ksp");
   visc_h_ = h;
 }
 
@@ -109,6 +113,11 @@ void FluidSolver::diffuse(double h) {
   for (int q = 0; q < 2; ++q) {
     copy_owned(u_[q], x_, false);
     MG_PETSC(VecWAXPY(rhs_, 1.0, x_, b_visc_[q]));
+    if (spectral_visc_[q]) {
+      spectral_visc_[q]->solve_negated(rhs_, x_);
+      copy_owned(u_[q], x_, true);
+      continue;
+    }
     MG_PETSC(KSPSolve(ksp_visc_[q], rhs_, x_));
     KSPConvergedReason reason;
     MG_PETSC(KSPGetConvergedReason(ksp_visc_[q], &reason));
