@@ -64,8 +64,8 @@ void DiffusionSolver::choose_spectral(const std::string& mode) {
       why = "-diffusion_solver ksp";
     else if (mode == "auto" && user_ksp)
       why = "a -diffusion_ksp_/-diffusion_pc_ option was given";
-    else if (!ops_.symmetric(s) || ops_.has_dirichlet())
-      why = "Dirichlet data, pinned cells or a non-symmetric operator";
+    else if (!ops_.symmetric(s))
+      why = "a non-symmetric operator";
     else
       spectral_[s] = SpectralSolver::create(grid_, ops_.M(s), &why);
     if (!spectral_[s] && mode == "spectral")
@@ -172,6 +172,10 @@ void DiffusionSolver::solve(int s, Vec u, double dt, double theta, PetscInt step
   const double c = dt * ops_.scale(s);
   if (use_spectral(s)) {
     spectral_[s]->step(u, c, theta);
+    if (ops_.has_dirichlet()) { // + c (I - theta c M)^-1 b: the boundary data's part
+      spectral_[s]->solve_shifted(ops_.b(s), tmp_, c, theta);
+      MG_PETSC(VecAXPY(u, c, tmp_));
+    }
     iterations_[s] = 0;
     return;
   }

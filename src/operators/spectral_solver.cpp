@@ -121,6 +121,20 @@ void SpectralSolver::solve_negated(Vec r, Vec x) {
   t.backward(x);
 }
 
+void SpectralSolver::solve_shifted(Vec r, Vec x, double c, double theta) {
+  SpectralTransform& t = *t_;
+  const size_t n = t.entries(), w = static_cast<size_t>(t.width());
+  t.forward(r);
+  double* sp = t.spectrum();
+  const double inv_n = 1.0 / t.norm();
+  for (size_t e = 0; e < n; ++e) {
+    const double g = inv_n / (1.0 - theta * c * lambda_[e]);
+    for (size_t k = 0; k < w; ++k)
+      sp[e * w + k] *= g;
+  }
+  t.backward(x);
+}
+
 void SpectralSolver::step(Vec u, double c, double theta) {
   SpectralTransform& t = *t_;
   const size_t n = t.entries(), w = static_cast<size_t>(t.width());

@@ -42,6 +42,8 @@ public:
 
   // u <- (I - theta c M)^-1 (I + (1 - theta) c M) u, in place on a global Vec.
   void step(Vec u, double c, double theta);
+  // x = (I - theta c M)^-1 r (the Dirichlet data's part of a substep).
+  void solve_shifted(Vec r, Vec x, double c, double theta);
   // x = (-M)^+ r: the solution of -M x = r without null modes (r must be orthogonal to them).
   void solve_negated(Vec r, Vec x);
 

@@ -5,10 +5,11 @@
 //      g = (1 + c lambda / 2) / (1 - c lambda / 2), lambda the 5-point symbol (each axis
 //      -4/h^2 sin^2(pi m / n), resp. sin^2(pi m / (2 n))), to 1e-12;
 //   2. a rough field (uniform +-20 % noise, every mode) on non-square grids (2-D 5pt and 9pt,
-//      periodic and zero flux, a rotated constant tensor with cross terms on a periodic grid;
-//      3-D 7pt periodic and mixed periodic / zero flux), spectral against KSP at rtol 1e-13:
+//      periodic, zero flux and Dirichlet (DST-II, boundary data in b), a rotated constant tensor
+//      with cross terms on a periodic grid; 3-D 7pt periodic and mixed periodic / zero flux /
+//      Dirichlet), spectral against KSP at rtol 1e-13:
 //      max difference <= 1e-10;
-//   3. where it does not apply (Dirichlet axes, varying coefficients, a tensor's cross terms on
+//   3. where it does not apply (pinned cells, varying coefficients, a tensor's cross terms on
 //      zero-flux axes) auto uses KSP and -diffusion_solver spectral is a UserError naming the
 //      option.
 #include "../mpi_expect.hpp"
@@ -102,12 +103,17 @@ TEST(SpectralDiffusion, AgreesWithKspOnRoughFields) {
                         Case{"16,10", "4,2.5", "9pt", "neumann,periodic", false},
                         Case{"20,12", "5,3", "5pt", "periodic", true},
                         Case{"10,8,6", "2.5,2,1.5", "7pt", "periodic", false},
-                        Case{"10,8,7", "2.5,2,1.75", "7pt", "periodic,neumann,periodic", false}}) {
+                        Case{"10,8,7", "2.5,2,1.75", "7pt", "periodic,neumann,periodic", false},
+                        Case{"18,11", "4.5,2.75", "5pt", "dirichlet", false},
+                        Case{"16,10", "4,2.5", "9pt", "dirichlet,periodic", false},
+                        Case{"10,8,7", "2.5,2,1.75", "7pt", "neumann,dirichlet,periodic", false}}) {
     SCOPED_TRACE(std::string(k.n) + " " + k.stencil + " " + k.bc + (k.tensor ? " tensor" : ""));
     auto with = [&](const char* solver) {
       OptionList o = diffusion_case(k.n, k.L, "1 +- 20%", solver);
       o.push_back({"stencil", k.stencil});
       o.push_back({"grid_bc", k.bc});
+      if (std::string(k.bc).find("dirichlet") != std::string::npos)
+        o.insert(o.end(), {{"dirichlet_a", "0.7 + 0.2*x"}, {"dirichlet_b", "1.3"}});
       if (k.tensor)
         o.insert(o.end(), {{"diffusion", "tensor"},
                            {"tensor_theta", "0.4"},
@@ -137,7 +143,7 @@ TEST(SpectralDiffusion, AgreesWithKspOnRoughFields) {
 
 // Each case: auto falls back to KSP, -diffusion_solver spectral is a UserError naming it.
 TEST(SpectralDiffusion, FallsBackWhereItDoesNotApply) {
-  const std::vector<OptionList> cases = {{{"grid_bc", "dirichlet"}},
+  const std::vector<OptionList> cases = {{{"pin_a", "x < 1"}},
                                          {{"D_a", "0.5 + 0.2*x/3"}},
                                          {{"grid_bc", "neumann"},
                                           {"diffusion", "tensor"},
