@@ -5,6 +5,7 @@
 #include <petscdmda.h>
 #include <petscviewerhdf5.h>
 
+#include <array>
 #include <cstring>
 
 namespace morphogen::io {
@@ -267,39 +268,99 @@ std::optional<ImageInfo> inspect_vtkhdf(const std::string& path, std::string& wh
   return info;
 }
 
-VtkHdfIO::VtkHdfIO(const Grid& grid) : grid_(grid) {
-  PetscInt procs[3] = {1, 1, 1};
-  MG_PETSC(DMDAGetInfo(grid.dm(), nullptr, nullptr, nullptr, nullptr, &procs[0], &procs[1],
-                       &procs[2], nullptr, nullptr, nullptr, nullptr, nullptr, nullptr));
-  const auto ranges = grid.ownership_ranges();
-  const PetscInt one = 1;
-  const auto& n = grid.spec().n;
-  MG_PETSC(DMDACreate3d(grid.comm(), DM_BOUNDARY_NONE, DM_BOUNDARY_NONE, DM_BOUNDARY_NONE,
-                        DMDA_STENCIL_STAR, n[0], n[1], grid.dim() == 3 ? n[2] : 1, procs[0],
-                        procs[1], grid.dim() == 3 ? procs[2] : 1, 1, 0, ranges[0].data(),
-                        ranges[1].data(), grid.dim() == 3 ? ranges[2].data() : &one, dm3_.out()));
-  MG_PETSC(DMSetUp(dm3_));
-  MG_PETSC(DMCreateGlobalVector(dm3_, io_.out()));
+VtkHdfIO::VtkHdfIO(const Grid& grid) : grid_(grid) {}
+
+namespace {
+
+// The owned box of `grid` as a hyperslab of the (nz, ny, nx) dataset space `file` and of the
+// (gz, gy, gx) ghosted local array `mem` (z slowest; 2-D grids have nz = gz = 1).
+PetscErrorCode select_owned(const Grid& grid, hid_t file, hid_t mem) {
+  PetscFunctionBeginUser;
+  const Box &ob = grid.owned(), &gb = grid.ghosted();
+  hsize_t fstart[3], mstart[3], count[3];
+  for (int d = 0; d < 3; ++d) { // HDF5 order: z, y, x
+    fstart[2 - d] = static_cast<hsize_t>(ob.s[d]);
+    mstart[2 - d] = static_cast<hsize_t>(ob.s[d] - gb.s[d]);
+    count[2 - d] = static_cast<hsize_t>(ob.m[d]);
+  }
+  MG_H5(H5Sselect_hyperslab(file, H5S_SELECT_SET, fstart, nullptr, count, nullptr));
+  MG_H5(H5Sselect_hyperslab(mem, H5S_SELECT_SET, mstart, nullptr, count, nullptr));
+  PetscFunctionReturn(0);
 }
 
-PetscErrorCode VtkHdfIO::copy_owned(Vec local, Vec io, bool to_io) const {
+// Dataspaces of the grid's (nz, ny, nx) dataset and of this rank's ghosted local array.
+std::array<hsize_t, 3> file_dims(const Grid& grid) {
+  const auto& n = grid.spec().n;
+  return {static_cast<hsize_t>(grid.dim() == 3 ? n[2] : 1), static_cast<hsize_t>(n[1]),
+          static_cast<hsize_t>(n[0])};
+}
+std::array<hsize_t, 3> mem_dims(const Grid& grid) {
+  const Box& gb = grid.ghosted();
+  return {static_cast<hsize_t>(gb.m[2]), static_cast<hsize_t>(gb.m[1]),
+          static_cast<hsize_t>(gb.m[0])};
+}
+
+// A transfer property list for collective MPI-IO (every rank takes part in every dataset's
+// write or read); negative on failure.
+hid_t collective_xfer() {
+  const hid_t dxpl = H5Pcreate(H5P_DATASET_XFER);
+  if (dxpl >= 0 && H5Pset_dxpl_mpio(dxpl, H5FD_MPIO_COLLECTIVE) < 0) {
+    H5Pclose(dxpl);
+    return -1;
+  }
+  return dxpl;
+}
+
+} // namespace
+
+PetscErrorCode VtkHdfIO::write_field(hid_t group, const std::string& name, Vec local,
+                                     bool single_precision) const {
   PetscFunctionBeginUser;
-  const Box& ob = grid_.owned();
-  PetscScalar *l, *g;
-  PetscCall(VecGetArray(local, &l));
-  PetscCall(VecGetArray(io, &g));
-  const size_t row = static_cast<size_t>(ob.m[0]) * sizeof(PetscScalar);
-  for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
-    for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j) {
-      PetscScalar* lr = l + grid_.local_index(ob.s[0], j, k);
-      PetscScalar* gr = g + grid_.owned_index(ob.s[0], j, k);
-      if (to_io)
-        std::memcpy(gr, lr, row);
-      else
-        std::memcpy(lr, gr, row);
-    }
-  PetscCall(VecRestoreArray(io, &g));
-  PetscCall(VecRestoreArray(local, &l));
+  const auto fd = file_dims(grid_), md = mem_dims(grid_);
+  H5Id fspace(H5Screate_simple(3, fd.data(), nullptr), H5Sclose);
+  H5Id mspace(H5Screate_simple(3, md.data(), nullptr), H5Sclose);
+  H5Id dxpl(collective_xfer(), H5Pclose);
+  MG_H5(fspace.id);
+  MG_H5(mspace.id);
+  MG_H5(dxpl.id);
+  PetscCall(select_owned(grid_, fspace, mspace));
+  H5Id ds(H5Dcreate2(group, name.c_str(), single_precision ? H5T_IEEE_F32LE : H5T_IEEE_F64LE,
+                     fspace, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+          H5Dclose);
+  MG_H5(ds.id);
+  const PetscScalar* a;
+  PetscCall(VecGetArrayRead(local, &a));
+  const herr_t st = H5Dwrite(ds, H5T_NATIVE_DOUBLE, mspace, fspace, dxpl, a);
+  PetscCall(VecRestoreArrayRead(local, &a));
+  MG_H5(st);
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode VtkHdfIO::read_field(hid_t group, const std::string& name, Vec local) const {
+  PetscFunctionBeginUser;
+  const auto fd = file_dims(grid_), md = mem_dims(grid_);
+  H5Id ds(H5Dopen2(group, name.c_str(), H5P_DEFAULT), H5Dclose);
+  if (!ds.ok()) SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "no dataset %s", name.c_str());
+  H5Id fspace(H5Dget_space(ds), H5Sclose);
+  MG_H5(fspace.id);
+  hsize_t have[3] = {0, 0, 0};
+  if (H5Sget_simple_extent_ndims(fspace) != 3 ||
+      H5Sget_simple_extent_dims(fspace, have, nullptr) < 0 || have[0] != fd[0] ||
+      have[1] != fd[1] || have[2] != fd[2])
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED,
+            "dataset %s is not of shape (%llu, %llu, %llu)", name.c_str(),
+            static_cast<unsigned long long>(fd[0]), static_cast<unsigned long long>(fd[1]),
+            static_cast<unsigned long long>(fd[2]));
+  H5Id mspace(H5Screate_simple(3, md.data(), nullptr), H5Sclose);
+  H5Id dxpl(collective_xfer(), H5Pclose);
+  MG_H5(mspace.id);
+  MG_H5(dxpl.id);
+  PetscCall(select_owned(grid_, fspace, mspace));
+  PetscScalar* a;
+  PetscCall(VecGetArray(local, &a));
+  const herr_t st = H5Dread(ds, H5T_NATIVE_DOUBLE, mspace, fspace, dxpl, a);
+  PetscCall(VecRestoreArray(local, &a));
+  MG_H5(st);
   PetscFunctionReturn(0);
 }
 
@@ -310,17 +371,17 @@ PetscErrorCode VtkHdfIO::write_impl(const std::string& path, const std::vector<s
   PetscViewer v;
   PetscCall(PetscViewerHDF5Open(grid_.comm(), path.c_str(), FILE_MODE_WRITE, &v));
   PetscCall(PetscViewerHDF5SetCollective(v, PETSC_TRUE)); // MPI-IO collective transfers
-  PetscCall(PetscViewerHDF5SetSPOutput(v, single_precision ? PETSC_TRUE : PETSC_FALSE));
-  PetscCall(PetscViewerHDF5PushGroup(v, "/VTKHDF/PointData"));
-  for (size_t s = 0; s < fields.size(); ++s) {
-    PetscCall(copy_owned(fields[s], io_, true));
-    PetscCall(PetscObjectSetName(reinterpret_cast<PetscObject>(io_.get()), names[s].c_str()));
-    PetscCall(VecView(io_, v));
-  }
-  PetscCall(PetscViewerHDF5PopGroup(v));
-
   hid_t file, vtk, mg;
   PetscCall(PetscViewerHDF5GetFileId(v, &file));
+  {
+    H5Id root(H5Gcreate2(file, "/VTKHDF", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+    H5Id points(H5Gcreate2(file, "/VTKHDF/PointData", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+                H5Gclose);
+    MG_H5(root.id);
+    MG_H5(points.id);
+    for (size_t s = 0; s < fields.size(); ++s)
+      PetscCall(write_field(points, names[s], fields[s], single_precision));
+  }
   MG_H5_ID(vtk, H5Gopen2(file, "/VTKHDF", H5P_DEFAULT));
   const auto& sp = grid_.spec();
   const int version[2] = {1, 0};
@@ -364,13 +425,13 @@ PetscErrorCode VtkHdfIO::read_impl(const std::string& path, const std::vector<st
   PetscCall(PetscViewerHDF5GetFileId(v, &file));
   const htri_t points = H5Lexists(file, "/VTKHDF/PointData", H5P_DEFAULT);
   const htri_t cells = points > 0 ? 0 : H5Lexists(file, "/VTKHDF/CellData", H5P_DEFAULT);
-  PetscCall(PetscViewerHDF5PushGroup(v, cells > 0 ? "/VTKHDF/CellData" : "/VTKHDF/PointData"));
-  for (size_t s = 0; s < fields.size(); ++s) {
-    PetscCall(PetscObjectSetName(reinterpret_cast<PetscObject>(io_.get()), names[s].c_str()));
-    PetscCall(VecLoad(io_, v));
-    PetscCall(copy_owned(fields[s], io_, false));
+  {
+    H5Id group(H5Gopen2(file, cells > 0 ? "/VTKHDF/CellData" : "/VTKHDF/PointData", H5P_DEFAULT),
+               H5Gclose);
+    MG_H5(group.id);
+    for (size_t s = 0; s < fields.size(); ++s)
+      PetscCall(read_field(group, names[s], fields[s]));
   }
-  PetscCall(PetscViewerHDF5PopGroup(v));
   PetscCall(PetscViewerDestroy(&v));
   PetscFunctionReturn(0);
 }

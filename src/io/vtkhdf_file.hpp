@@ -14,12 +14,14 @@
 // as cell data with bounds = the domain. Files of an earlier development version stored them as
 // /VTKHDF/CellData/<s> of an image of the cell corners (WholeExtent {0,nx, 0,ny, 0,nz}, z 0..0 in
 // 2-D, Origin 0): they are still read (inspect_vtkhdf and VtkHdfIO::read accept both layouts).
-// Fields are written and read collectively by PETSc's HDF5 viewer (MPI-IO hyperslabs, never
-// gathered on one rank) through a 3-D DMDA with the run's ownership ranges (2-D grids get
-// nz = 1), so a file written on any number of ranks loads on any other.
+// Fields are written and read collectively (MPI-IO): each rank transfers the hyperslab of its
+// owned box straight from or into its ghosted local array (an HDF5 memory selection, no copy
+// and no gather), so a file written on any number of ranks loads on any other.
 #pragma once
 
 #include "grid/grid.hpp"
+
+#include <hdf5.h>
 
 #include <optional>
 #include <string>
@@ -79,11 +81,12 @@ private:
                             const H5Attributes& attributes) const;
   PetscErrorCode read_impl(const std::string& path, const std::vector<std::string>& names,
                            const std::vector<Vec>& fields) const;
-  PetscErrorCode copy_owned(Vec from, Vec to, bool to_io) const;
+  // One dataset <group>/<name> of shape (nz, ny, nx) from / into the owned cells of `local`.
+  PetscErrorCode write_field(hid_t group, const std::string& name, Vec local,
+                             bool single_precision) const;
+  PetscErrorCode read_field(hid_t group, const std::string& name, Vec local) const;
 
   const Grid& grid_;
-  DMH dm3_; // 3-D DMDA matching the grid's decomposition (nz = 1 for 2-D)
-  VecH io_; // global vector on dm3_
 };
 
 } // namespace morphogen::io
