@@ -205,7 +205,8 @@ void compute_spectrum(const double* u, const FieldShape2D& s, PatternMetrics& m)
 // truncated and renormalised at the ends).
 void box_line(double* a, int n, std::ptrdiff_t stride, int r, bool periodic,
               std::vector<double>& prefix) {
-  prefix.assign(static_cast<std::size_t>(n) + 1, 0.0);
+  prefix.resize(static_cast<std::size_t>(n) + 1);
+  prefix[0] = 0.0;
   for (int i = 0; i < n; ++i)
     prefix[i + 1] = prefix[i] + a[i * stride];
   const double total = prefix[n];
@@ -225,10 +226,24 @@ void box_line(double* a, int n, std::ptrdiff_t stride, int r, bool periodic,
 
 void box_filter(std::vector<double>& f, const FieldShape2D& s, int rx, int ry) {
   std::vector<double> prefix;
-  for (int j = 0; j < s.ny; ++j)
-    box_line(f.data() + static_cast<std::size_t>(s.nx) * j, s.nx, 1, rx, s.periodic_x, prefix);
-  for (int i = 0; i < s.nx; ++i)
-    box_line(f.data() + i, s.ny, s.nx, ry, s.periodic_y, prefix);
+  const std::size_t nx = static_cast<std::size_t>(s.nx), ny = static_cast<std::size_t>(s.ny);
+  for (std::size_t j = 0; j < ny; ++j)
+    box_line(f.data() + nx * j, s.nx, 1, rx, s.periodic_x, prefix);
+  // Columns in blocks of kBlock, copied to contiguous lines and back (row-wise memory access;
+  // the same operations per column as filtering it in place).
+  constexpr std::size_t kBlock = 16;
+  std::vector<double> cols(kBlock * ny);
+  for (std::size_t i0 = 0; i0 < nx; i0 += kBlock) {
+    const std::size_t b = std::min(kBlock, nx - i0);
+    for (std::size_t j = 0; j < ny; ++j)
+      for (std::size_t c = 0; c < b; ++c)
+        cols[c * ny + j] = f[i0 + c + nx * j];
+    for (std::size_t c = 0; c < b; ++c)
+      box_line(cols.data() + c * ny, s.ny, 1, ry, s.periodic_y, prefix);
+    for (std::size_t j = 0; j < ny; ++j)
+      for (std::size_t c = 0; c < b; ++c)
+        f[i0 + c + nx * j] = cols[c * ny + j];
+  }
 }
 
 void compute_coherence(const double* u, const FieldShape2D& s, PatternMetrics& m) {

@@ -1,6 +1,7 @@
 #include "app/deck.hpp"
 
 #include "app/model_decks.hpp"
+#include "app/solver_option_check.hpp"
 #include "core/options.hpp"
 #include "core/petsc_handle.hpp"
 #include "core/user_error.hpp"
@@ -120,6 +121,27 @@ void refuse_late_deck(int argc, char** argv) {
   }
 }
 
+// A word that is neither an option nor an option's value ("-dt 0.1 junk", a value the shell
+// split: -init_a 4 + x): PETSc would skip it silently. PETSc's own rule tells names from values.
+void refuse_stray_words(int argc, char** argv, int first) {
+  const auto is_key = [](const char* a) {
+    PetscBool key = PETSC_FALSE;
+    MG_PETSC(PetscOptionsValidKey(a, &key));
+    return key == PETSC_TRUE;
+  };
+  std::string last; // the last option with its value, for the message
+  for (int i = first; i < argc; ++i) {
+    if (is_key(argv[i])) {
+      last = argv[i];
+      if (i + 1 < argc && !is_key(argv[i + 1])) last += std::string(" ") + argv[++i]; // its value
+      continue;
+    }
+    throw UserError("'" + std::string(argv[i]) + "'" + (last.empty() ? "" : " after " + last) +
+                    ": not an option name and not an option's value (options are -name value; "
+                    "quote a value that has spaces, e.g. -init_a \"4 + x\")");
+  }
+}
+
 } // namespace
 
 std::string check_deck_text(const std::string& text, const std::string& name) {
@@ -162,6 +184,7 @@ std::string load_deck(int* argc, char*** argv, const std::vector<OptionsFileArg>
   std::string deck, base_dir;
   if (*argc > 1 && (*argv)[1][0] != '-') deck = (*argv)[1];
   refuse_late_deck(*argc, *argv);
+  refuse_stray_words(*argc, *argv, deck.empty() ? 1 : 2);
   if (!deck.empty()) {
     insert_yaml("deck ", deck);
     // Absolute, so that options_used.yaml (which records it as -deck_dir) reruns from anywhere.
@@ -175,6 +198,7 @@ std::string load_deck(int* argc, char*** argv, const std::vector<OptionsFileArg>
     insert_options_file(f);
   // The command line overrides the deck and the options files.
   MG_PETSC(PetscOptionsInsert(nullptr, argc, argv, nullptr));
+  check_solver_option_values();
   return base_dir;
 }
 

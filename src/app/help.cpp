@@ -21,7 +21,7 @@ const std::vector<std::pair<const char*, std::vector<const char*>>>& topics() {
         "source_", "pin_", "clamp", "seed"}},
       {"Grid", {"grid_", "stencil", "sequence_"}},
       {"Diffusion", {"diffusion", "tensor_", "surface_", "polar_", "shaped_"}},
-      {"Time integration", {"integrator", "dt", "force_dt", "steps", "split_", "ts_"}},
+      {"Time integration", {"integrator", "dt", "force_dt", "steps", "split_", "ts_", "explicit_"}},
       {"Advection", {"advect", "velocity_", "fluid"}},
       {"Checkpoints and restart", {"checkpoint_", "restart", "max_walltime"}},
       {"Output",

@@ -36,8 +36,31 @@ bool run_loop(Simulation& sim, PetscInt end_step, RunOutput& output, PngOutput& 
   if (sim.level() == 0) warn_if_reaction_stiff(sim);
   if (sim.fluid()) PetscPrintf(comm, "%s\n", sim.fluid()->describe().c_str());
   if (sim.advection()) PetscPrintf(comm, "%s\n", sim.advection()->describe().c_str());
+  // Steps in the pass starting at loop step n: up to sim.fuse_steps(), ending before any step
+  // that checks, writes, samples or reports something (those end a pass).
+  auto pass_length = [&](PetscInt n) {
+    const PetscInt kmax = std::min(sim.fuse_steps(), steps - n + 1);
+    double t = sim.time();
+    PetscInt b = 1;
+    for (; b < kmax; ++b) {
+      const PetscInt m = n + b - 1, index = first + m;
+      t += sim.dt(); // the clock after step m, as Simulation advances it
+      const bool png = out.png_every > 0 && index % out.png_every == 0;
+      if (m % out.nan_check_every == 0 || m % out.progress_every == 0 || png ||
+          !output.quiet_at(sim, index, t))
+        break;
+    }
+    return b;
+  };
+  PetscInt passes = 0;
   for (PetscInt n = 1; n <= steps; ++n) {
-    sim.step();
+    const PetscInt pass = pass_length(n);
+    sim.advance(pass);
+    ++passes;
+    if (pass > 1) {
+      output.count_fused_steps(sim, pass - 1);
+      n += pass - 1;
+    }
     if (n % out.nan_check_every == 0 || n == steps) check_finite();
     if (output.after_step(sim)) {
       PetscPrintf(comm,
@@ -67,6 +90,10 @@ bool run_loop(Simulation& sim, PetscInt end_step, RunOutput& output, PngOutput& 
       step_last = n;
     }
   }
+  if (sim.fuse_steps() > 1)
+    PetscPrintf(comm, "fused steps: %lld steps in %lld passes (up to %lld steps each)\n",
+                static_cast<long long>(steps), static_cast<long long>(passes),
+                static_cast<long long>(std::min(sim.fuse_steps(), steps)));
   if (final_level) {
     check_finite();
     std::snprintf(tag, sizeof tag, "%07lld", static_cast<long long>(sim.step_index()));

@@ -236,6 +236,16 @@ int RunOutput::poll_stop_flags(const Simulation& sim) {
   return flags;
 }
 
+bool RunOutput::quiet_at(const Simulation& sim, PetscInt n, double t) const {
+  const auto& out = sim.output();
+  const double tol = 1e-9 * sim.dt();
+  if (out.snapshot_every > 0 && n % out.snapshot_every == 0) return false;
+  if (out.snapshot_every_time > 0 && t >= next_snapshot_time_ - tol) return false;
+  if (out.checkpoint_every > 0 && n % out.checkpoint_every == 0) return false;
+  if (out.checkpoint_every_time > 0 && t >= next_checkpoint_time_ - tol) return false;
+  return !(out.summary && n % sample_every_ == 0);
+}
+
 bool RunOutput::after_step(Simulation& sim) {
   const auto& out = sim.output();
   const long long n = sim.step_index();

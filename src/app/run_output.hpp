@@ -58,6 +58,13 @@ public:
   void begin(Simulation& sim, long long restart_step, PetscInt end_step);
   // After every step. Returns true when the run must stop (a checkpoint has been written).
   bool after_step(Simulation& sim);
+  // True when after_step at step n, time t would write nothing and take no sample (steps that
+  // may fall inside a fused block; stop signals are polled at the block's end).
+  bool quiet_at(const Simulation& sim, PetscInt n, double t) const;
+  // A fused block of b steps ended: after_step counts one, this the other b - 1.
+  void count_fused_steps(const Simulation& sim, PetscInt extra) {
+    cell_updates_ += static_cast<double>(extra) * static_cast<double>(sim.grid().global_cells());
+  }
   // Final snapshot and checkpoint of the last level, and summary.json: per species the pattern
   // class and metrics (with the run's dynamics from samples taken every 1/1000 of the run),
   // and the linear stability of the parameters.

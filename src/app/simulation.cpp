@@ -31,6 +31,7 @@ Simulation::Simulation(MPI_Comm comm, Options& opt, const std::string& base_dir,
   read_time(opt);
   fluid_ = read_fluid(opt, *grid_, seed_, base_dir);
   advection_ = read_advection(opt, *grid_, species_, seed_, base_dir, dt_, fluid_.get());
+  read_fuse(opt);
   read_output(opt);
   if (level.coarser) start_from(*level.coarser);
 }
@@ -460,6 +461,12 @@ void Simulation::read_split(Options& opt) {
                             "relative tolerance of the per-cell Newton solve");
   set.newton_max_it = static_cast<int>(
       opt.integer("split_newton_max_it", 20, 1, 1000, "Newton iteration cap per cell"));
+  split_fuse_ = opt.flag(
+      "split_fuse_reaction", false,
+      "Strang: merge the reaction half-steps of consecutive steps that no output, sample, "
+      "progress line or NaN check separates (n - 1 fewer reaction substeps per n steps, still "
+      "second order; the trajectory then depends on the output times to splitting-error order, "
+      "so restarts are not bitwise)");
   matrices_ = std::make_unique<OperatorMatrices>(*grid_, *halo_, stencil_, operators(),
                                                  dirichlet_.empty() ? nullptr : &dirichlet_);
   keep_timed_patterns();
@@ -514,7 +521,10 @@ void Simulation::read_output(Options& opt) {
       throw UserError("-png_species " + n + ": no such species in model " + model_->name +
                       ", allowed " + all);
     }
-    out_.png_species.push_back(static_cast<int>(it - species_.begin()));
+    const int s = static_cast<int>(it - species_.begin());
+    if (std::find(out_.png_species.begin(), out_.png_species.end(), s) != out_.png_species.end())
+      throw UserError("-png_species: species " + n + " given twice");
+    out_.png_species.push_back(s);
   }
   out_.png_range.assign(species_.size(), {1.0, 0.0});
   for (size_t s = 0; s < species_.size(); ++s) {
@@ -548,6 +558,11 @@ void Simulation::read_snapshot_options(Options& opt) {
                                   "qrstuvwxyz0123456789_-.") != std::string::npos)
     throw UserError("-output_name " + out_.name +
                     ": allowed characters are letters, digits, '_', '-' and '.'");
+  // File names are NAME_<step>.vtkhdf and the like (and MPI-IO adds its own suffixes): keep
+  // them well inside the file system's 255-byte limit.
+  if (out_.name.size() > 200)
+    throw UserError("-output_name " + out_.name.substr(0, 40) + "...: " +
+                    std::to_string(out_.name.size()) + " characters, allowed at most 200");
   out_.snapshot_every = opt.integer("snapshot_every", 0, 0, imax,
                                     "write a VTKHDF snapshot every N steps and at step 0 (0: "
                                     "only the final state)");
@@ -590,6 +605,57 @@ void Simulation::step() {
   }
   t_ += dt_;
   ++step_;
+}
+
+// -explicit_fuse_steps k: temporal blocking of the explicit integrator where it applies;
+// elsewhere one step per pass, with a log line saying why.
+void Simulation::read_fuse(Options& opt) {
+  const char* key = "explicit_fuse_steps";
+  if (split_ || ts_) {
+    if (opt.is_set(key))
+      throw UserError("-explicit_fuse_steps: applies to -integrator explicit only");
+    if (split_fuse_) read_split_fuse();
+    return;
+  }
+  const PetscInt k = opt.integer(
+      key, 1, 1, 64,
+      "explicit steps fused per pass over the grid (temporal blocking: a k-cell halo exchanged "
+      "once per k steps; 2-D periodic fast path, else 1; results bitwise those of 1)");
+  integrator_->set_fuse_steps(static_cast<int>(k));
+  std::string why = integrator_->fuse_unsupported();
+  if (why.empty() && timed_->any()) why = "parameters constant in time";
+  if (why.empty() && (fluid_ || advection_)) why = "no advection or fluid";
+  fuse_ = why.empty() ? k : 1;
+  if (k > 1 && !why.empty())
+    PetscPrintf(comm_, "explicit_fuse_steps %lld: fused steps need %s; one step per pass\n",
+                static_cast<long long>(k), why.c_str());
+}
+
+// -split_fuse_reaction: fused Strang passes as long as nothing observes the state (the run loop
+// ends a pass there), where the run has no per-step work besides the split step.
+void Simulation::read_split_fuse() {
+  std::string why = split_integrator_->fuse_unsupported();
+  if (why.empty() && timed_->any()) why = "parameters constant in time";
+  if (why.empty() && (fluid_ || advection_)) why = "no advection or fluid";
+  fuse_ = why.empty() ? kMaxFusedSplitSteps : 1;
+  if (!why.empty())
+    PetscPrintf(comm_, "split_fuse_reaction: fused steps need %s; one step per pass\n",
+                why.c_str());
+}
+
+void Simulation::advance(PetscInt n) {
+  if (n <= 1) {
+    step();
+    return;
+  }
+  if (split_)
+    split_integrator_->steps(u_, t_, dt_, step_ + 1, static_cast<int>(n));
+  else
+    integrator_->steps(u_, t_, dt_, static_cast<int>(n));
+  for (PetscInt i = 0; i < n; ++i) { // the clock of n single steps, bit for bit
+    t_ += dt_;
+    ++step_;
+  }
 }
 
 std::vector<const DiffusionOperator*> Simulation::operators() const {

@@ -93,6 +93,10 @@ public:
 
   // Advance one step with the configured integrator.
   void step();
+  // Steps advance() may take in one pass (-explicit_fuse_steps where it applies, else 1).
+  PetscInt fuse_steps() const { return fuse_; }
+  // Advance n <= fuse_steps() steps, bitwise the same as n calls of step() (no output between).
+  void advance(PetscInt n);
   // The run's terms and constraints (what the integrators consume).
   const TermList& terms() const { return terms_; }
   bool split() const { return split_; }
@@ -108,6 +112,10 @@ public:
   void check_finite() const;
 
 private:
+  void read_fuse(Options& opt);
+  void read_split_fuse();
+  static constexpr PetscInt kMaxFusedSplitSteps = 1 << 20; // a pass ends at any observation
+  PetscInt fuse_ = 1; // steps per pass of the explicit integrator (temporal blocking)
   void read_grid(Options& opt, const SequenceLevel& level);
   void start_from(Simulation& coarser);
   void read_diffusion_kinds(Options& opt, const std::string& stencil);
@@ -158,6 +166,7 @@ private:
   std::unique_ptr<FluidSolver> fluid_;        // before the advection stage (-fluid)
   std::unique_ptr<AdvectionStage> advection_; // after every integrator's step (-advect)
   bool split_ = false, ts_ = false, ts_implicit_diffusion_ = true;
+  bool split_fuse_ = false;   // -split_fuse_reaction: fused Strang passes (advance())
   PetscInt level_factor_ = 1; // coarsening factor of this sequencing level (1: finest)
   int level_index_ = 0;
   std::uint64_t seed_ = 1;

@@ -11,10 +11,13 @@
 // explicit vs split (target >= 4x faster, same pattern). Runs on any number of ranks (aggregate
 // figures). Before all that (-bench_output_n, issue 13 parts 3-4, bench/bench_output.hpp): the
 // setup ns per cell, the PNG time and the peak memory per cell at 4096^2. Last line:
+// Then (-bench_fuse_steps, bench/bench_fused.hpp): fused explicit steps (temporal blocking) at
+// 2048^2 and 4096^2 against one step per pass and the roofline. Last line:
 //   roofline_fraction=<2-D fraction>
 #include "app/pattern_summary.hpp"
 #include "app/simulation.hpp"
 #include "bench/bench_fluids.hpp"
+#include "bench/bench_fused.hpp"
 #include "bench/bench_output.hpp"
 #include "bench/bench_scaling.hpp"
 #include "bench/bench_timing.hpp"
@@ -215,6 +218,23 @@ double seconds_per_step(MPI_Comm comm, Options& opt, const OptionPairs& o, int s
   return best_seconds_per_step(comm, sim, steps, 3);
 }
 
+// Seconds per step of passes of `steps` fused steps (best of 3, after 2 single warm-up steps).
+double seconds_per_fused_step(MPI_Comm comm, Options& opt, const OptionPairs& o, int steps) {
+  set_case(o);
+  Simulation sim(comm, opt, "");
+  sim.step();
+  sim.step();
+  double best = 1e30;
+  for (int rep = 0; rep < 3; ++rep) {
+    MPI_Barrier(comm);
+    const double t0 = MPI_Wtime();
+    sim.advance(std::min<PetscInt>(steps, sim.fuse_steps()));
+    MPI_Barrier(comm);
+    best = std::min(best, (MPI_Wtime() - t0) / steps);
+  }
+  return best;
+}
+
 // The per-cell reaction substep alone: nanoseconds per cell of the Strang half-step (dt 0.05,
 // trapezoidal, tol 1e-12) for Brusselator cells spread +-30 % around the steady state (a formed
 // pattern's range), the per-cell solver (reaction_row) against the lockstep one.
@@ -281,6 +301,14 @@ void bench_split_vs_explicit(MPI_Comm comm, Options& opt, int n, int steps) {
                 "split_step_ms=%.3f explicit_step_ms=%.4f ratio=%.1f target_ratio<=10 %s\n",
                 n, n, solver, 1e3 * sp, 1e3 * ex, sp / ex, sp / ex <= 10.0 ? "met" : "NOT met");
   }
+  OptionPairs fused = brusselator_deck(n, "split", "0.1", "auto");
+  fused.push_back({"-split_fuse_reaction", "true"});
+  const double fu = seconds_per_fused_step(comm, opt, fused, steps);
+  PetscPrintf(
+      comm,
+      "split_vs_explicit grid=%dx%d model=brusselator diffusion_solver=auto fused_passes=%d "
+      "split_step_ms=%.3f explicit_step_ms=%.4f ratio=%.1f target_ratio<=10 %s\n",
+      n, n, steps, 1e3 * fu, 1e3 * ex, fu / ex, fu / ex <= 10.0 ? "met" : "NOT met");
 }
 
 struct DeckRun {
@@ -294,8 +322,11 @@ DeckRun run_deck(MPI_Comm comm, Options& opt, const OptionPairs& o, PetscInt ste
   Simulation sim(comm, opt, "");
   MPI_Barrier(comm);
   const double t0 = MPI_Wtime();
-  for (PetscInt i = 0; i < steps; ++i)
-    sim.step();
+  for (PetscInt i = 0; i < steps;) { // passes of fused steps where the case fuses them
+    const PetscInt pass = std::min(sim.fuse_steps(), steps - i);
+    sim.advance(pass);
+    i += pass;
+  }
   MPI_Barrier(comm);
   DeckRun r;
   r.seconds = MPI_Wtime() - t0;
@@ -311,6 +342,20 @@ DeckRun run_deck(MPI_Comm comm, Options& opt, const OptionPairs& o, PetscInt ste
   return r;
 }
 
+// The fused-Strang run (-split_fuse_reaction) of the deck against the explicit one.
+void report_fused_deck(MPI_Comm comm, double T, double split_dt, PetscInt steps, const DeckRun& ex,
+                       const DeckRun& fu) {
+  const double dspots = ex.spots ? std::fabs(double(fu.spots - ex.spots)) / ex.spots : 1.0;
+  const double dlam = ex.wavelength > 0 ? std::fabs(fu.wavelength / ex.wavelength - 1.0) : 1.0;
+  const double speedup = ex.seconds / fu.seconds;
+  const bool same = fu.cls == ex.cls && dspots <= 0.05 && dlam <= 0.02;
+  PetscPrintf(comm,
+              "brusselator_deck T=%g split_fused dt=%g steps=%d seconds=%.2f class=%s spots=%ld "
+              "wavelength=%.2f speedup_vs_explicit=%.2f target>=4 %s; same pattern: %s\n",
+              T, split_dt, static_cast<int>(steps), fu.seconds, fu.cls.c_str(), fu.spots,
+              fu.wavelength, speedup, speedup >= 4.0 ? "met" : "NOT met", same ? "yes" : "NO");
+}
+
 // input/brusselator.yaml to t = T: explicit dt 0.0025 against split dt `split_dt` (species a).
 void bench_brusselator_deck(MPI_Comm comm, Options& opt, double T, double split_dt) {
   const PetscInt ex_steps = static_cast<PetscInt>(std::lround(T / 0.0025));
@@ -319,6 +364,9 @@ void bench_brusselator_deck(MPI_Comm comm, Options& opt, double T, double split_
   std::snprintf(dt_text, sizeof dt_text, "%.17g", split_dt);
   const DeckRun ex = run_deck(comm, opt, brusselator_deck(256, "explicit", "0.0025"), ex_steps);
   const DeckRun sp = run_deck(comm, opt, brusselator_deck(256, "split", dt_text), sp_steps);
+  OptionPairs fused_case = brusselator_deck(256, "split", dt_text);
+  fused_case.push_back({"-split_fuse_reaction", "true"});
+  const DeckRun fu = run_deck(comm, opt, fused_case, sp_steps);
   const double dspots = ex.spots ? std::fabs(double(sp.spots - ex.spots)) / ex.spots : 1.0;
   const double dlam = ex.wavelength > 0 ? std::fabs(sp.wavelength / ex.wavelength - 1.0) : 1.0;
   const double speedup = ex.seconds / sp.seconds;
@@ -337,6 +385,7 @@ void bench_brusselator_deck(MPI_Comm comm, Options& opt, double T, double split_
               "(class, spots +-5%%, wavelength +-2%%): %s (spots %.1f%%, wavelength %.1f%%)\n",
               speedup, speedup >= 4.0 ? "met" : "NOT met", same ? "yes" : "NO", 100 * dspots,
               100 * dlam);
+  report_fused_deck(comm, T, split_dt, sp_steps, ex, fu);
 }
 
 int run(MPI_Comm comm) {
@@ -393,6 +442,10 @@ int run(MPI_Comm comm) {
     PetscPrintf(comm, "halo_%s halo_only_update_ms=%.4f dm_global_to_local_ms=%.4f\n", tag,
                 1e3 * r.halo_s, 1e3 * r.g2l_s);
   };
+  const bool only_fused =
+      opt.flag("bench_only_fused", false, "only the fused-steps (temporal blocking) section");
+  if (!only_implicit) bench_fused(comm, opt, roof);
+  if (only_fused) return 0;
   if (with_implicit) {
     bench_reaction_kernel(comm);
     bench_split_vs_explicit(comm, opt, 256, static_cast<int>(split_steps) * 4);

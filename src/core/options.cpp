@@ -159,7 +159,9 @@ double Options::parse_real(const std::string& name, const std::string& text) {
   const double v = std::strtod(text.c_str(), &end);
   while (end && *end == ' ')
     ++end;
-  if (text.empty() || !end || *end != '\0' || errno == ERANGE || std::isnan(v))
+  // (no hexadecimal "0x10", which strtod would take: integers and expressions refuse it too)
+  if (text.empty() || !end || *end != '\0' || errno == ERANGE || std::isnan(v) ||
+      text.find_first_of("xX") != std::string::npos)
     throw UserError("-" + name + " " + text + ": not a number");
   return v;
 }
@@ -261,6 +263,9 @@ std::vector<std::string> Options::list(const std::string& name, const std::vecto
       const auto b = item.find_first_not_of(" \t"), e = item.find_last_not_of(" \t");
       v.push_back(b == std::string::npos ? "" : item.substr(b, e - b + 1));
     }
+    // "16,16," has an empty last value (getline drops it): refused like "16,,16" by the caller.
+    const auto last = s->find_last_not_of(" \t");
+    if (last != std::string::npos && (*s)[last] == ',') v.push_back("");
   } else {
     v = def;
   }

@@ -80,6 +80,8 @@ void check_spots_args(double n, double radius, double seed) {
                           ", allowed an integer in [0, 2^53]");
 }
 
+} // namespace
+
 // A top-level '=' (an assignment: muParser would assign to x) or ',' (a list: muParser would
 // evaluate every item and keep the last) in an expression: "" if none, else the message.
 std::string top_level_problem(const std::string& expr) {
@@ -99,8 +101,6 @@ std::string top_level_problem(const std::string& expr) {
   }
   return {};
 }
-
-} // namespace
 
 // muParser callbacks (user data = the ValueSpec being evaluated).
 struct ValueSpecFunctions {

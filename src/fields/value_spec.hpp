@@ -52,6 +52,10 @@ namespace morphogen {
 // Cap on spots(n, ...): every cell tests every spot, so n bounds the setup time.
 inline constexpr long kMaxSpots = 100000;
 
+// A top-level '=' (assignment) or ',' (list) in a muParser expression: "" if none, else what is
+// wrong and what is allowed (for the one-line error).
+std::string top_level_problem(const std::string& expr);
+
 class ValueSpec {
 public:
   // key: the option name (used in error messages and as the random stream name).

@@ -145,6 +145,10 @@ void DiffusionSolver::configure(int s) {
   if (!err.empty())
     throw UserError("-diffusion_ksp_*/-diffusion_pc_* options: PETSc refused them (" +
                     one_line(err) + "); see -help petsc for the KSP and PC types");
+  // -diffusion_ksp_type preonly (with a direct PC: lu, cholesky) takes no initial guess.
+  PetscBool preonly = PETSC_FALSE;
+  MG_PETSC(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(ksp), KSPPREONLY, &preonly));
+  if (preonly) MG_PETSC(KSPSetInitialGuessNonzero(ksp, PETSC_FALSE));
 }
 
 void DiffusionSolver::prepare_species(int s, double dt, double theta) {
@@ -154,6 +158,7 @@ void DiffusionSolver::prepare_species(int s, double dt, double theta) {
   MG_PETSC(MatShift(A_[s], 1.0));
   MG_PETSC(KSPSetOperators(ksp_[s], A_[s], A_[s]));
   if (assembled_dt_[s] < 0 && ops_.symmetric(s)) icc_subblocks(ksp_[s], "-diffusion_sub_pc_type");
+  if (assembled_dt_[s] < 0 && !ops_.symmetric(s)) set_up_or_refuse(ksp_[s], "-diffusion_");
   assembled_dt_[s] = dt;
   assembled_theta_[s] = theta;
 }

@@ -17,17 +17,25 @@
 //   u^{n+1} = C( sweep(u^n) + dt sum_k T_k(u^n, t) )
 // Diffusion coefficients and Dirichlet values using t are set at the step's start t^n
 // (TermList::set_time) before the halo update, so the ghosts carry g(t^n).
+// Temporal blocking (-explicit_fuse_steps k, integrators/fused_sweep.hpp): steps(u, t, dt, n)
+// advances n <= k steps in one pass with a k r wide halo exchanged once; bitwise the same as n
+// calls of step(). Only the fast path on a 2-D grid periodic on both axes, with no terms or
+// constraints besides the kernel's floor (fuse_unsupported() says which condition fails; then
+// fuse_steps() is 1); parameters must not change between steps (the caller's check).
 #pragma once
 
 #include "fields/param_set.hpp"
 #include "grid/halo.hpp"
 #include "grid/stencil.hpp"
 #include "integrators/explicit_kernel.hpp"
+#include "integrators/fused_sweep.hpp"
 #include "integrators/integrator.hpp"
 #include "operators/diffusion_operator.hpp"
 #include "operators/term_list.hpp"
 
 #include <functional>
+#include <memory>
+#include <string>
 #include <vector>
 
 namespace morphogen {
@@ -61,6 +69,17 @@ public:
   void use_operators(std::vector<const DiffusionOperator*> ops, PreFn pre_fn);
   bool general() const { return !ops_.empty(); }
 
+  // Temporal blocking: up to k >= 1 steps per pass (1: one step per pass, the default).
+  void set_fuse_steps(int k) { fuse_request_ = k; }
+  // Why this run cannot fuse steps ("" when it can).
+  std::string fuse_unsupported() const;
+  // Steps steps() may fuse: the requested k where supported, else 1.
+  int fuse_steps() const {
+    return fuse_request_ > 1 && fuse_unsupported().empty() ? fuse_request_ : 1;
+  }
+  // n steps (1 <= n <= fuse_steps()) from t with step dt: bitwise n calls of step(). Collective.
+  void steps(std::vector<VecH>& u, double t, double dt, int n);
+
 private:
   void sweep(std::vector<VecH>& u, std::vector<VecH>& work, double dt) const;
   void add_other_terms(std::vector<VecH>& u, double t, double dt);
@@ -86,6 +105,8 @@ private:
   bool constrain_after_sweep_ = false;     // constraints other than the kernel's clamp floor
   std::vector<VecH> work_;                 // second state set (created on the first step)
   std::vector<std::vector<double>> rates_; // owned layout, per species (other terms)
+  int fuse_request_ = 1;
+  std::unique_ptr<FusedSweep> fused_; // built on the first fused call
 };
 
 } // namespace morphogen

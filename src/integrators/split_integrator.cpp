@@ -146,10 +146,38 @@ void SplitIntegrator::step(std::vector<VecH>& u, double t, double dt, PetscInt s
       diffuse(u, sub.fraction * dt, step);
     }
   }
+  constrain(u);
+}
+
+void SplitIntegrator::constrain(std::vector<VecH>& u) const {
   if (terms_)
     terms_->constrain(u);
   else
     apply_floor(grid_, u, floor_);
+}
+
+std::string SplitIntegrator::fuse_unsupported() const {
+  if (set_.ordering != SplitOrdering::Strang) return "Strang ordering";
+  if (terms_ && (terms_->any_state_dependent() || terms_->any_time_dependent()))
+    return "diffusion coefficients and boundary values constant in time and state";
+  return {};
+}
+
+void SplitIntegrator::steps(std::vector<VecH>& u, double t, double dt, PetscInt first, int n) {
+  if (n <= 1 || !fuse_unsupported().empty()) {
+    for (int i = 0; i < n; ++i)
+      step(u, t + i * dt, dt, first + i);
+    return;
+  }
+  react(u, t, 0.5 * dt, first);
+  if (terms_) terms_->constrain(u);
+  for (int i = 0; i < n; ++i) {
+    diffuse(u, dt, first + i);
+    // The merged substep spans the second half of step i and the first half of step i + 1.
+    react(u, t + (i + 0.5) * dt, i + 1 < n ? dt : 0.5 * dt, first + i);
+    if (terms_) terms_->constrain(u);
+  }
+  constrain(u);
 }
 
 } // namespace morphogen

@@ -14,6 +14,10 @@
 // reaction substeps and at the end of the step. Diffusion coefficients and Dirichlet values
 // using t are set at the diffusion substep's midpoint t + dt/2 (TermList::set_time; the matrices
 // of the species whose coefficients changed are re-assembled, constant-in-time runs untouched).
+// Fused Strang (steps(), when nothing observes the state between the n steps of a pass): the
+// reaction half-steps of consecutive steps merge into one,
+//   R(dt/2) D(dt) [R(dt) D(dt)]^(n-1) R(dt/2),
+// the same order (second) with n - 1 fewer reaction substeps; a pass of 1 step is step().
 #pragma once
 
 #include "fields/param_set.hpp"
@@ -24,6 +28,7 @@
 #include "operators/term_list.hpp"
 
 #include <functional>
+#include <string>
 #include <vector>
 
 namespace morphogen {
@@ -62,6 +67,13 @@ public:
   // One step from t to t + dt on the ghosted local state vectors (owned cells updated).
   void step(std::vector<VecH>& u, double t, double dt, PetscInt step) override;
 
+  // n >= 1 Strang steps from t in one pass (fused reaction half-steps, see above); `first` is the
+  // number of the pass's first step. Needs fuse_unsupported() empty.
+  void steps(std::vector<VecH>& u, double t, double dt, PetscInt first, int n);
+  // Why steps() cannot fuse this run ("" if it can): Lie ordering, coefficients that follow the
+  // state or t (they are refreshed per step).
+  std::string fuse_unsupported() const;
+
   // The run's constraints (pinned cells, clamp floor), applied after every reaction substep
   // and at the end of the step (without: the clamp floor only).
   void use_constraints(const TermList& terms) { terms_ = &terms; }
@@ -72,6 +84,7 @@ public:
 private:
   void react(std::vector<VecH>& u, double t0, double dt, PetscInt step);
   void diffuse(std::vector<VecH>& u, double dt, PetscInt step);
+  void constrain(std::vector<VecH>& u) const;
 
   const Grid& grid_;
   ReactionRowFn fn_;

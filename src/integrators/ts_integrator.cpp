@@ -270,7 +270,7 @@ void TsIntegrator::setup_implicit_solver(double dt) {
   if (symmetric)
     icc_subblocks(ksp, "-sub_pc_type");
   else
-    MG_PETSC(KSPSetUp(ksp));
+    set_up_or_refuse(ksp, "-");
 }
 
 // ---- PETSc callbacks: no exception may leave them -------------------------------------------

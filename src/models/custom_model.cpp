@@ -1,5 +1,6 @@
 // User-defined kinetics from muParser expressions (see models/runtime_model.hpp).
 #include "core/user_error.hpp"
+#include "fields/value_spec.hpp"
 #include "models/runtime_model.hpp"
 #include "models/runtime_storage.hpp"
 
@@ -358,6 +359,8 @@ std::unique_ptr<mu::Parser> parse_one(const std::string& text, const std::string
   if (text.find_first_not_of(" \t") == std::string::npos)
     throw UserError(key + ": empty expression (on the command line a value that starts with "
                           "'-' is read as an option name: write \"0 - k*a\" or \" -k*a\")");
+  if (const std::string bad = top_level_problem(text); !bad.empty())
+    throw UserError(key + " " + text + ": " + bad);
   try {
     P->DefineConst("pi", M_PI);
     P->SetExpr(text);

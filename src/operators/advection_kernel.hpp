@@ -44,9 +44,11 @@ struct WideGeom {
   }
 };
 
-// Halo width (cells) a back-trace of Courant number `courant` needs.
+// Halo width (cells) a back-trace of Courant number `courant` needs. A Courant number beyond
+// 1e9 (or not finite) is capped there: far wider than any halo, and no overflowing cast.
 MG_HD inline long long advection_reach(double courant, Interp interp) {
-  return static_cast<long long>(std::floor(courant)) + (interp == Interp::Cubic ? 3 : 2);
+  const double c = courant < 1e9 ? courant : 1e9;
+  return static_cast<long long>(std::floor(c)) + (interp == Interp::Cubic ? 3 : 2);
 }
 
 // Position along axis d clamped to the boundary cells' centres on a non-periodic axis.

@@ -112,7 +112,7 @@ double divergence_rhs(const Grid& grid, const double* const u[2], double* rhs,
 } // namespace
 
 void FluidSolver::solve_pressure_ksp() {
-  MG_PETSC(KSPSolve(ksp_pois_, rhs_, p_));
+  fluid_ksp_solve(ksp_pois_, rhs_, p_, set_.option_text + " pressure solve", "fluid_");
   KSPConvergedReason reason;
   MG_PETSC(KSPGetConvergedReason(ksp_pois_, &reason));
   MG_PETSC(KSPGetIterationNumber(ksp_pois_, &poisson_its_));

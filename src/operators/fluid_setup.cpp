@@ -4,6 +4,8 @@
 #include "core/user_error.hpp"
 #include "fields/value_spec.hpp"
 
+#include <algorithm>
+
 namespace morphogen {
 
 namespace {
@@ -19,6 +21,9 @@ std::vector<double> obstacle(Options& opt, const Grid& grid, std::uint64_t seed,
                  "solid obstacle of the fluid: cells where this expression of x, y is > 0.5 (e.g. "
                  "\"(x-0.3*Lx)^2+(y-0.5*Ly)^2 < (0.1*Lx)^2\"); zero velocity, no-slip");
   ValueSpec spec("fluid_obstacle", text, grid.spec(), seed, base_dir);
+  if (spec.uses_time())
+    throw UserError("-fluid_obstacle " + text +
+                    ": the obstacle cannot depend on t (it is evaluated once, at the start)");
   std::vector<double> m(static_cast<size_t>(grid.owned().size()));
   std::string err;
   try {
@@ -30,6 +35,12 @@ std::vector<double> obstacle(Options& opt, const Grid& grid, std::uint64_t seed,
     err = e.what();
   }
   throw_if_any(grid.comm(), err);
+  long long fluid_cells = std::count_if(m.begin(), m.end(), [](double v) { return !(v > 0.5); });
+  MPI_Allreduce(MPI_IN_PLACE, &fluid_cells, 1, MPI_LONG_LONG, MPI_SUM, grid.comm());
+  if (fluid_cells == 0)
+    throw UserError("-fluid_obstacle " + text +
+                    ": the obstacle (cells where it is > 0.5) covers every cell; allowed: an "
+                    "obstacle that leaves fluid cells");
   return m;
 }
 

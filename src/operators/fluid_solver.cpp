@@ -103,7 +103,13 @@ void FluidSolver::configure_ksp(KSP* ksp, const char* prefix, bool poisson) {
   check_type_name(p + "ksp_type", KSPList, "KSP");
   check_type_name(p + "pc_type", PCList, "PC");
   const std::string err = petsc_quietly([&] { return KSPSetFromOptions(*ksp); });
-  if (err.empty()) return;
+  if (err.empty()) {
+    // -fluid_ksp_type preonly (with a direct PC: lu, cholesky) takes no initial guess.
+    PetscBool preonly = PETSC_FALSE;
+    MG_PETSC(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(*ksp), KSPPREONLY, &preonly));
+    if (preonly) MG_PETSC(KSPSetInitialGuessNonzero(*ksp, PETSC_FALSE));
+    return;
+  }
   const std::string named = name_petsc_option_error(p, err);
   throw UserError(!named.empty() ? named
                                  : "-" + p + "ksp_*/-" + p + "pc_* options: PETSc refused them (" +
@@ -240,6 +246,16 @@ std::string FluidSolver::describe() const {
          " substep(s) per step, " + (set_.interp == advect::Interp::Cubic ? "cubic" : "linear") +
          " self-advection, pressure solve " +
          (spectral_pois_ ? std::string("spectral (FFT/DCT, exact)") : std::string(kt) + "/" + pt);
+}
+
+void fluid_ksp_solve(KSP ksp, Vec b, Vec x, const std::string& what, const std::string& prefix) {
+  const std::string err = petsc_quietly([&] { return KSPSolve(ksp, b, x); });
+  if (err.empty()) return;
+  throw UserError(what + ": PETSc could not run the solve with the -" + prefix + "ksp_*/-" +
+                  prefix + "pc_* options (" + one_line(err) + ")" +
+                  (err.find("KSPSetDM") != std::string::npos
+                       ? "; with -" + prefix + "pc_type mg add -" + prefix + "pc_mg_galerkin both"
+                       : ""));
 }
 
 } // namespace morphogen

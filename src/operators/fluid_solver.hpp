@@ -118,4 +118,8 @@ private:
   void solve_pressure_ksp();
 };
 
+// KSPSolve of one of the fluid's solves; a PETSc refusal at the solver's setup (e.g. -fluid_pc_type
+// mg without -fluid_pc_mg_galerkin) is a one-line UserError naming `what` and the options prefix.
+void fluid_ksp_solve(KSP ksp, Vec b, Vec x, const std::string& what, const std::string& prefix);
+
 } // namespace morphogen

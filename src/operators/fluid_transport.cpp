@@ -118,7 +118,7 @@ void FluidSolver::diffuse(double h) {
       copy_owned(u_[q], x_, true);
       continue;
     }
-    MG_PETSC(KSPSolve(ksp_visc_[q], rhs_, x_));
+    fluid_ksp_solve(ksp_visc_[q], rhs_, x_, set_.option_text + " viscosity solve", "fluid_visc_");
     KSPConvergedReason reason;
     MG_PETSC(KSPGetConvergedReason(ksp_visc_[q], &reason));
     if (reason < 0)

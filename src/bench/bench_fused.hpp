@@ -1,0 +1,14 @@
+// The temporal-blocking section of morphogen-bench (-bench_fuse_steps, issue 13 part 2): explicit
+// Gray-Scott cell-updates per second at the grid sides -bench_fuse_n (2-D, periodic, the
+// -bench_fuse_stencil stencil) with k = 1 and each fused depth k of -bench_fuse_steps, the ratio
+// to k = 1 and to the single-step bandwidth roofline `roof` (target >= 1.5 at 4096^2). One
+// Simulation per grid, built with the largest k (a pass of n <= k steps is exact for any n).
+#pragma once
+
+#include "core/options.hpp"
+
+namespace morphogen {
+
+void bench_fused(MPI_Comm comm, Options& opt, double roof);
+
+} // namespace morphogen

@@ -1,0 +1,69 @@
+// Temporal blocking of the explicit fast path (2-D, periodic axes): n <= k forward-Euler steps
+// in one pass over the grid,
+//   u^{m+1} = max( u^m + dt (D L u^m + R(u^m; p)), floor ),   m = 0 .. n-1,
+// each cell of each step computed by the model's fused row kernel (explicit_kernel.hpp) from
+// the same neighbours as a single step, so the result is bitwise that of n single steps.
+//
+// Halo: a frame k r cells wide (grid/frame_halo.hpp, r the stencil radius) filled once per
+// call; the owned cells are read in place. Box rows jw = 0 .. Ly-1 and columns iw = 0 .. Lx-1
+// (the owned box grown by W = k r). Step l (1..n) computes the box shrunk by
+// e_l = W - (n - l) r on each side, so step n yields exactly the owned box. Wavefront along y:
+// after input row jw is assembled (left strip, owned row, right strip), step l computes its row
+// jw - l r, whose neighbours rows jw - l r +- r of step l - 1 are ready. Each step keeps a ring
+// of 2r + 1 rows per species (2r + 1 rows of Lx cells per step and species stay in cache); the
+// last step writes the owned row of the output arrays. Memory traffic per n steps: one read
+// and one write of the state, instead of n of each.
+// Per-cell parameters (field mode): each field is copied once into the wide box (WideHalo) and
+// each scalar into a row of Lx copies (set_params); they must not change afterwards.
+#pragma once
+
+#include "fields/param_set.hpp"
+#include "grid/frame_halo.hpp"
+#include "grid/stencil.hpp"
+#include "integrators/explicit_kernel.hpp"
+
+#include <vector>
+
+namespace morphogen {
+
+class FusedSweep {
+public:
+  using RowFn = void (*)(const ExplicitRow&);
+  // Up to `depth` >= 1 steps per call of `nspecies` species with the 2-D row stencil `rows`
+  // (one grid row per y offset rows.off[q][0]). Collective (builds the frame halo).
+  FusedSweep(const Grid& grid, const RowStencil& rows, int nspecies, int depth);
+
+  // Field mode: the parameters of every cell of the wide box (fields fixed in time). Collective.
+  void set_params(const ParamSet& params);
+
+  // The stencil radius along y (x taps always reach 1 cell).
+  static int radius(const RowStencil& rows);
+  int depth() const { return depth_; }
+
+  // n steps (1 <= n <= depth): in[s], out[s] ghosted local arrays of species s (owned cells of
+  // `in` current; the owned cells of `out` written). `row` carries w, D, floor, pconst and dt;
+  // src, dst and n are set here. Collective.
+  void run(const std::vector<const double*>& in, const std::vector<double*>& out, int n,
+           ExplicitRow row, RowFn fn) const;
+
+private:
+  double* ring_row(int level, int s, PetscInt jw) const {
+    const size_t slot = static_cast<size_t>(jw % ring_);
+    return ring_buf_.data() + ((static_cast<size_t>(level) * ns_ + s) * ring_ + slot) * stride_;
+  }
+  const double* input_row(const std::vector<const double*>& in, int s, PetscInt jw) const;
+
+  const Grid& grid_;
+  RowStencil rows_;
+  int ns_, depth_, r_;
+  FrameHalo frame_;
+  PetscInt ring_;                                       // rows per ring: 2r + 1
+  PetscInt stride_;                                     // doubles per ring row
+  mutable std::vector<std::vector<double>> frame_buf_;  // per species
+  mutable std::vector<double> ring_buf_;                // [level][species][slot][stride]
+  mutable std::vector<std::vector<const double*>> in0_; // level 0 rows per species and slot
+  std::vector<std::vector<double>> pwide_; // field mode: per parameter, Lx * Ly or Lx cells
+  std::vector<bool> pfield_;               // parameter q is a field (else one row of Lx)
+};
+
+} // namespace morphogen
