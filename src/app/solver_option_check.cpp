@@ -1,5 +1,6 @@
 #include "app/solver_option_check.hpp"
 
+#include "core/options.hpp"
 #include "core/petsc_handle.hpp"
 #include "core/user_error.hpp"
 
@@ -39,23 +40,6 @@ const Rule kRules[] = {
     {"snes_max_it", 0, kBig, false, false, true, "allowed an integer >= 0"},
 };
 
-// Every (name, value) in the options database, without marking any as used.
-std::vector<std::pair<std::string, std::string>> all_options() {
-  char* text = nullptr;
-  MG_PETSC(PetscOptionsGetAll(nullptr, &text));
-  std::stringstream ss(text ? text : "");
-  MG_PETSC(PetscFree(text));
-  std::vector<std::pair<std::string, std::string>> all;
-  std::string tok;
-  while (ss >> tok) {
-    if (tok.size() > 1 && tok[0] == '-' && std::isalpha(static_cast<unsigned char>(tok[1])))
-      all.emplace_back(tok.substr(1), "");
-    else if (!all.empty())
-      all.back().second += (all.back().second.empty() ? "" : " ") + tok;
-  }
-  return all;
-}
-
 bool ends_with(const std::string& a, const std::string& e) {
   return a.size() >= e.size() && a.compare(a.size() - e.size(), e.size(), e) == 0;
 }
@@ -73,7 +57,7 @@ bool breaks(const Rule& r, const std::string& v) {
 } // namespace
 
 void check_solver_option_values() {
-  for (const auto& [name, value] : all_options())
+  for (const auto& [name, value] : all_petsc_options())
     for (const Rule& r : kRules)
       if ((name == r.suffix || ends_with(name, std::string("_") + r.suffix)) && breaks(r, value))
         throw UserError("-" + name + " " + value + ": out of range, " + r.allowed);

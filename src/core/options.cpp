@@ -64,12 +64,12 @@ std::string one_line(const std::string& text) {
   return out;
 }
 
-std::string name_petsc_option_error(const std::string& prefix, const std::string& petsc_message) {
+std::vector<std::pair<std::string, std::string>> all_petsc_options() {
   char* text = nullptr;
   if (PetscOptionsGetAll(nullptr, &text) || !text) return {};
   std::stringstream ss(text);
   PetscFree(text);
-  std::vector<std::pair<std::string, std::string>> all; // (name, value) under prefix
+  std::vector<std::pair<std::string, std::string>> all;
   std::string tok;
   while (ss >> tok) {
     if (tok.size() > 1 && tok[0] == '-' && std::isalpha(static_cast<unsigned char>(tok[1])))
@@ -77,8 +77,12 @@ std::string name_petsc_option_error(const std::string& prefix, const std::string
     else if (!all.empty())
       all.back().second += (all.back().second.empty() ? "" : " ") + tok;
   }
+  return all;
+}
+
+std::string name_petsc_option_error(const std::string& prefix, const std::string& petsc_message) {
   const std::string msg = one_line(petsc_message);
-  for (const auto& [name, value] : all) {
+  for (const auto& [name, value] : all_petsc_options()) {
     if (name.compare(0, prefix.size(), prefix) != 0 || value.empty()) continue;
     if (msg.find(" " + value + " ") == std::string::npos &&
         msg.find(": " + value) == std::string::npos)

@@ -96,6 +96,10 @@ std::string format_number(double v);
 // +inf or the largest double, "allowed <= 1" when lo is -inf or the lowest double, "any number".
 std::string allowed_range(double lo, double hi);
 
+// Every (name without '-', value) in the PETSc options database, read as text (no option is
+// marked used); a name followed by no value has "".
+std::vector<std::pair<std::string, std::string>> all_petsc_options();
+
 // PETSc's refusal `petsc_message` of an option under `prefix` (e.g. "diffusion_"), said as
 // "-diffusion_ksp_rtol abc: not a number (PETSc: ...)": the option is the one whose value the
 // message quotes. "" when no option under prefix matches.

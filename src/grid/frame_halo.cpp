@@ -8,19 +8,6 @@
 
 namespace morphogen {
 
-namespace {
-
-// Owner and first index of each process's range along one axis.
-struct Ranges {
-  std::vector<PetscInt> start, count;
-  PetscInt owner(PetscInt i) const {
-    const auto it = std::upper_bound(start.begin(), start.end(), i);
-    return static_cast<PetscInt>(it - start.begin()) - 1;
-  }
-};
-
-} // namespace
-
 FrameHalo::FrameHalo(const Grid& grid, int width) : width_(width) {
   const GridSpec& g = grid.spec();
   if (grid.dim() != 2 || g.bc[0] != Boundary::Periodic || g.bc[1] != Boundary::Periodic ||
@@ -29,18 +16,7 @@ FrameHalo::FrameHalo(const Grid& grid, int width) : width_(width) {
   const Box& ob = grid.owned();
   lx_ = ob.m[0] + 2 * width;
   ly_ = ob.m[1] + 2 * width;
-  PetscInt P[2];
-  MG_PETSC(DMDAGetInfo(grid.dm(), nullptr, nullptr, nullptr, nullptr, &P[0], &P[1], nullptr,
-                       nullptr, nullptr, nullptr, nullptr, nullptr, nullptr));
-  const PetscInt* lr[2] = {nullptr, nullptr};
-  MG_PETSC(DMDAGetOwnershipRanges(grid.dm(), &lr[0], &lr[1], nullptr));
-  Ranges ax[2];
-  for (int d = 0; d < 2; ++d)
-    for (PetscInt p = 0, s = 0; p < P[d]; ++p) {
-      ax[d].start.push_back(s);
-      ax[d].count.push_back(lr[d][p]);
-      s += lr[d][p];
-    }
+  const auto ax = grid.axis_ranges();
   const PetscInt sw = g.stencil_width; // the owners' ghosted local arrays
   std::vector<PetscSFNode> remotes;
   auto add = [&](PetscInt i, PetscInt j) { // global (unwrapped) cell of the frame
@@ -49,7 +25,7 @@ FrameHalo::FrameHalo(const Grid& grid, int width) : width_(width) {
     const PetscInt gs0 = ax[0].start[p0] - sw, gs1 = ax[1].start[p1] - sw;
     const PetscInt gm0 = ax[0].count[p0] + 2 * sw;
     PetscSFNode r;
-    r.rank = p0 + P[0] * p1;
+    r.rank = p0 + static_cast<PetscInt>(ax[0].start.size()) * p1;
     r.index = (c[0] - gs0) + gm0 * (c[1] - gs1);
     remotes.push_back(r);
   };

@@ -86,6 +86,20 @@ std::array<std::vector<PetscInt>, 3> Grid::ownership_ranges() const {
   return r;
 }
 
+std::array<Grid::AxisRanges, 3> Grid::axis_ranges() const {
+  const auto l = ownership_ranges();
+  std::array<AxisRanges, 3> ax;
+  for (int d = 0; d < 3; ++d) {
+    const std::vector<PetscInt> counts = d < spec_.dim ? l[d] : std::vector<PetscInt>{1};
+    for (PetscInt p = 0, s = 0; p < static_cast<PetscInt>(counts.size()); ++p) {
+      ax[d].start.push_back(s);
+      ax[d].count.push_back(counts[p]);
+      s += counts[p];
+    }
+  }
+  return ax;
+}
+
 VecH Grid::create_global() const {
   VecH v;
   MG_PETSC(DMCreateGlobalVector(dm_, v.out()));

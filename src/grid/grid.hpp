@@ -9,6 +9,7 @@
 
 #include "core/petsc_handle.hpp"
 
+#include <algorithm>
 #include <array>
 #include <string>
 #include <vector>
@@ -75,6 +76,16 @@ public:
   VecH create_local() const;
   // Cells per process along each axis (what GridSpec::ranges would reproduce).
   std::array<std::vector<PetscInt>, 3> ownership_ranges() const;
+  // Per axis: each process's first index and count (axes beyond dim(): one process, 1 cell),
+  // and the owner of an index.
+  struct AxisRanges {
+    std::vector<PetscInt> start, count;
+    PetscInt owner(PetscInt i) const {
+      const auto it = std::upper_bound(start.begin(), start.end(), i);
+      return static_cast<PetscInt>(it - start.begin()) - 1;
+    }
+  };
+  std::array<AxisRanges, 3> axis_ranges() const;
   VecH create_global() const;
 
 private:

@@ -8,15 +8,6 @@ namespace morphogen {
 
 namespace {
 
-// Owned range of each process along one axis.
-struct Ranges {
-  std::vector<PetscInt> start, count;
-  PetscInt owner(PetscInt i) const {
-    const auto it = std::upper_bound(start.begin(), start.end(), i);
-    return static_cast<PetscInt>(it - start.begin()) - 1;
-  }
-};
-
 // The wide box: owned +- width, clipped to [0, n) along non-periodic axes.
 Box wide_box(const Grid& grid, int width) {
   const GridSpec& g = grid.spec();
@@ -38,19 +29,7 @@ Box wide_box(const Grid& grid, int width) {
 WideHalo::WideHalo(const Grid& grid, int width)
     : grid_(grid), width_(width), box_(wide_box(grid, width)) {
   const GridSpec& g = grid.spec();
-  PetscInt P[3];
-  MG_PETSC(DMDAGetInfo(grid.dm(), nullptr, nullptr, nullptr, nullptr, &P[0], &P[1], &P[2], nullptr,
-                       nullptr, nullptr, nullptr, nullptr, nullptr));
-  const PetscInt* lx[3] = {nullptr, nullptr, nullptr};
-  MG_PETSC(DMDAGetOwnershipRanges(grid.dm(), &lx[0], &lx[1], &lx[2]));
-  Ranges ax[3];
-  for (int d = 0; d < 3; ++d)
-    for (PetscInt p = 0, s = 0; p < P[d]; ++p) {
-      const PetscInt c = d < grid.dim() ? lx[d][p] : 1;
-      ax[d].start.push_back(s);
-      ax[d].count.push_back(c);
-      s += c;
-    }
+  const auto ax = grid.axis_ranges();
   const int sw = g.stencil_width; // the owners' ghosted local arrays
   std::vector<PetscSFNode> remotes;
   remotes.reserve(static_cast<size_t>(box_.size()));
@@ -66,7 +45,8 @@ WideHalo::WideHalo(const Grid& grid, int width)
           gm[d] = ax[d].count[p[d]] + 2 * ghost;
         }
         PetscSFNode r;
-        r.rank = p[0] + P[0] * (p[1] + P[1] * p[2]);
+        r.rank = p[0] + static_cast<PetscInt>(ax[0].start.size()) *
+                            (p[1] + static_cast<PetscInt>(ax[1].start.size()) * p[2]);
         r.index = (c[0] - gs[0]) + gm[0] * ((c[1] - gs[1]) + gm[1] * (c[2] - gs[2]));
         remotes.push_back(r);
       }
