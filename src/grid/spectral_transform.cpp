@@ -1,5 +1,7 @@
 #include "grid/spectral_transform.hpp"
 
+#include "grid/fft_planning.hpp"
+
 #include <algorithm>
 #include <fftw3.h>
 #include <petscao.h>
@@ -60,7 +62,12 @@ SpectralTransform::SpectralTransform(const Grid& grid, const std::array<AxisKind
   realA_ = fftw_alloc_real(std::max<size_t>(1, nA * ncols_));
   specA_ = fftw_alloc_real(std::max<size_t>(1, nA * ncolsS_ * w_));
   specB_ = size_ == 1 ? specA_ : fftw_alloc_real(std::max<size_t>(1, entries() * w_));
+  fft_wisdom_load();
   plan(grid, kinds);
+  if (fft_wisdom_sync(grid.comm())) { // again, from the wisdom every rank now shares
+    plans_ = std::make_unique<Plans>();
+    plan(grid, kinds);
+  }
   if (size_ > 1) make_scatters(grid);
 }
 
@@ -90,7 +97,7 @@ void SpectralTransform::plan(const Grid& grid, const std::array<AxisKind, 3>& ki
   const int howA = static_cast<int>(a1_ - a0_), nb = static_cast<int>(nb_);
   const int S = static_cast<int>(S_), nc = static_cast<int>(ncols_),
             ncS = static_cast<int>(ncolsS_);
-  const unsigned flags = FFTW_ESTIMATE;
+  const unsigned flags = fft_planner_flags();
   Plans& p = *plans_;
   if (howA > 0 && w_ == 2) {
     auto* cA = reinterpret_cast<fftw_complex*>(specA_);

@@ -12,7 +12,8 @@
 // contiguous range of slow-axis planes, where T_rest runs; layout B gives each rank a range of
 // spectral columns (all slow-axis entries of them), where T_slow runs and where the spectrum
 // lives. Useful up to min(slow cells, spectral columns) ranks; on one rank nothing is scattered.
-// FFTW_ESTIMATE plans: the same arithmetic on every run.
+// Plans: grid/fft_planning.hpp (FFTW_MEASURE by default, kept in a wisdom file so that later
+// runs re-create the same plans and the same arithmetic).
 #pragma once
 
 #include "grid/grid.hpp"
