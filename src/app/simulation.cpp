@@ -49,6 +49,7 @@ void Simulation::start_from(Simulation& coarser) {
     MG_PETSC(VecRestoreArray(u_[s], &f));
     MG_PETSC(VecRestoreArrayRead(coarser.u_[s], &c));
   }
+  if (fluid_ && coarser.fluid_) fluid_->prolong_from(*coarser.fluid_);
   t_ = coarser.t_;
   step_ = coarser.step_;
   refresh_ghosts();

@@ -2,6 +2,7 @@
 
 #include "core/options.hpp"
 #include "core/user_error.hpp"
+#include "grid/prolong.hpp"
 
 #include <petscdmda.h>
 #include <petscksp.h>
@@ -228,6 +229,24 @@ void FluidSolver::state_restored() {
     refresh(u);
   copy_owned(p_local_, p_, false); // the next pressure solve starts from the restored p
   refresh(p_local_);
+}
+
+void FluidSolver::prolong_from(FluidSolver& coarse) {
+  coarse.state_restored(); // its ghosts current
+  const auto from = coarse.state(), to = state();
+  for (size_t i = 0; i < to.size(); ++i) {
+    const PetscScalar* c;
+    PetscScalar* f;
+    MG_PETSC(VecGetArrayRead(from[i].second, &c));
+    MG_PETSC(VecGetArray(to[i].second, &f));
+    prolong_cell_centred(coarse.grid_, c, grid_, f);
+    MG_PETSC(VecRestoreArray(to[i].second, &f));
+    MG_PETSC(VecRestoreArrayRead(from[i].second, &c));
+  }
+  zero_solid(u_[0]);
+  zero_solid(u_[1]);
+  state_restored();
+  project();
 }
 
 std::string FluidSolver::describe() const {

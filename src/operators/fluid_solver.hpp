@@ -77,6 +77,9 @@ public:
   // overwritten their owned cells, call state_restored(). Collective.
   std::vector<std::pair<std::string, Vec>> state() const;
   void state_restored();
+  // Grid sequencing: this flow from that of a grid half as fine per axis (same domain):
+  // velocity and pressure prolonged cell-centred, solids zeroed, then projected. Collective.
+  void prolong_from(FluidSolver& coarse);
   double speed_bound() const override;
   std::string option_text() const override { return set_.option_text; }
   std::string describe() const override;
