@@ -1,5 +1,7 @@
 #include "app/command_line.hpp"
 
+#include "app/log_file_check.hpp"
+
 #include <petscsys.h>
 
 namespace morphogen {
@@ -14,6 +16,15 @@ bool take_help(const std::string& a, const char* next, CommandLine& cl, bool& ke
     cl.help = petsc ? CommandLine::Help::Petsc : CommandLine::Help::Morphogen;
   keep = petsc; // PETSc sees -help (without "petsc")
   skip = petsc;
+  return true;
+}
+
+// True (and cl.error set) for -log_view/-log_trace with a file that cannot be written.
+bool take_bad_log_file(const std::string& a, const char* next, CommandLine& cl) {
+  if ((a != "-log_view" && a != "-log_trace") || !next || next[0] == '-') return false;
+  const std::string why = log_file_problem(a, next);
+  if (why.empty()) return false;
+  if (cl.error.empty()) cl.error = why;
   return true;
 }
 
@@ -38,6 +49,8 @@ CommandLine take_command_line(int* argc, char** argv) {
       }
       cl.options_files.push_back({a.substr(1), next});
       ++i;
+    } else if (take_bad_log_file(a, next, cl)) {
+      ++i; // dropped, so that PETSc does not fail on it (at PetscInitialize or PetscFinalize)
     } else {
       argv[out++] = argv[i];
     }

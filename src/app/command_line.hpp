@@ -6,6 +6,8 @@
 //                            PETSc object's options are printed as the objects are set up)
 //   -version, --version      morphogen's version and PETSc's
 //   -options_file F, -options_file_yaml F   loaded by load_deck (after the deck) instead
+//   -log_view V, -log_trace V  only when V names a file that cannot be written
+//                            (app/log_file_check.hpp): taken off, with `error` set
 #pragma once
 
 #include "app/deck.hpp"

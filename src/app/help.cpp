@@ -97,7 +97,8 @@ const Conditional kConditional[] = {
      "with -advect: halo width in cells (default 0: from max|u| dt/h at the start; at most 64)"},
     {"velocity_file", "-velocity_file FILE|A,B,..|S.series, -velocity_datasets X,Y[,Z]",
      "with -advect: velocity from HDF5/VTKHDF files instead of -velocity_x/_y: one file "
-     "(steady), a comma list or a .series JSON file (linear in t between frames, end frames "
+     "(steady), a comma list, a numbered pattern (flow_%04d.h5: from 0 or 1 to the first "
+     "missing) or a .series JSON file (linear in t between frames, end frames "
      "held outside); component datasets (default velocity_x,velocity_y[,velocity_z])"},
     {"velocity_time", "-velocity_times T1,T2,.., -velocity_time_attribute /object/name",
      "with a comma list in -velocity_file: the files' times (default: each file's attribute "

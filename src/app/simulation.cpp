@@ -21,6 +21,20 @@ namespace morphogen {
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kMaxReal = std::numeric_limits<double>::max(); // finite upper bound
+
+// Per species: why its diffusion matrix is re-assembled during the run ("" if it is not), for
+// the split solver's choice of KSP over the spectral solve.
+std::vector<std::string> varying_diffusion(const TermList& terms,
+                                           const std::vector<std::string>& species) {
+  std::vector<std::string> why(species.size());
+  const auto diff = terms.diffusion(static_cast<int>(species.size()));
+  for (size_t s = 0; s < species.size(); ++s)
+    if (dynamic_cast<const StateDiffusionTerm*>(diff[s]))
+      why[s] = "its coefficients follow the state (-diffusion_" + species[s] + " polar/shaped)";
+    else if (diff[s]->timed_coefficients())
+      why[s] = "its coefficients use t (-D_" + species[s] + " or -tensor_*)";
+  return why;
+}
 } // namespace
 
 Simulation::Simulation(MPI_Comm comm, Options& opt, const std::string& base_dir,
@@ -475,7 +489,8 @@ void Simulation::read_split(Options& opt) {
   keep_timed_patterns();
   pin_matrices();
   terms_.use_matrices(matrices_.get()); // lagged solution-dependent operators re-assembled
-  diffusion_ = std::make_unique<DiffusionSolver>(*grid_, *matrices_, species_, opt);
+  diffusion_ = std::make_unique<DiffusionSolver>(*grid_, *matrices_, species_, opt,
+                                                 varying_diffusion(terms_, species_));
   diffusion_->prepare(dt_, set.theta);
   split_integrator_ = std::make_unique<SplitIntegrator>(
       *grid_, model_->kernels.reaction_row[params_.any_field() ? 1 : 0], species_, params_, floor_,
@@ -625,9 +640,7 @@ void Simulation::read_fuse(Options& opt) {
       "explicit steps fused per pass over the grid (temporal blocking: a k-cell halo exchanged "
       "once per k steps; 2-D periodic fast path, else 1; results bitwise those of 1)");
   integrator_->set_fuse_steps(static_cast<int>(k));
-  std::string why = integrator_->fuse_unsupported();
-  if (why.empty() && timed_->any()) why = "parameters constant in time";
-  if (why.empty() && (fluid_ || advection_)) why = "no advection or fluid";
+  const std::string why = fuse_blocker(integrator_->fuse_unsupported());
   fuse_ = why.empty() ? k : 1;
   if (k > 1 && !why.empty())
     PetscPrintf(comm_, "explicit_fuse_steps %lld: fused steps need %s; one step per pass\n",
@@ -637,13 +650,19 @@ void Simulation::read_fuse(Options& opt) {
 // -split_fuse_reaction: fused Strang passes as long as nothing observes the state (the run loop
 // ends a pass there), where the run has no per-step work besides the split step.
 void Simulation::read_split_fuse() {
-  std::string why = split_integrator_->fuse_unsupported();
-  if (why.empty() && timed_->any()) why = "parameters constant in time";
-  if (why.empty() && (fluid_ || advection_)) why = "no advection or fluid";
+  const std::string why = fuse_blocker(split_integrator_->fuse_unsupported());
   fuse_ = why.empty() ? kMaxFusedSplitSteps : 1;
   if (!why.empty())
     PetscPrintf(comm_, "split_fuse_reaction: fused steps need %s; one step per pass\n",
                 why.c_str());
+}
+
+// What fused steps need that the run lacks: the integrator's reason `why` if any, else
+// parameters constant in time, else no advection or fluid; "" when steps can be fused.
+std::string Simulation::fuse_blocker(std::string why) const {
+  if (why.empty() && timed_->any()) why = "parameters constant in time";
+  if (why.empty() && (fluid_ || advection_)) why = "no advection or fluid";
+  return why;
 }
 
 void Simulation::advance(PetscInt n) {

@@ -114,6 +114,7 @@ public:
 private:
   void read_fuse(Options& opt);
   void read_split_fuse();
+  std::string fuse_blocker(std::string why) const;
   static constexpr PetscInt kMaxFusedSplitSteps = 1 << 20; // a pass ends at any observation
   PetscInt fuse_ = 1; // steps per pass of the explicit integrator (temporal blocking)
   void read_grid(Options& opt, const SequenceLevel& level);

@@ -7,7 +7,9 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -118,6 +120,49 @@ void bcast_string(MPI_Comm comm, std::string& s) {
   MPI_Bcast(s.data(), len, MPI_CHAR, 0, comm);
 }
 
+// The position and length of a printf integer conversion (%d, %4d, %04d) in text; npos if none.
+// Throws UserError for a '%' that is not one, or for more than one.
+std::pair<size_t, size_t> pattern_conversion(const std::string& text) {
+  size_t at = std::string::npos, len = 0;
+  for (size_t i = text.find('%'); i != std::string::npos; i = text.find('%', i + 1)) {
+    size_t j = i + 1;
+    while (j < text.size() && j - i <= 3 && std::isdigit(static_cast<unsigned char>(text[j])))
+      ++j;
+    if (j >= text.size() || text[j] != 'd' || at != std::string::npos)
+      throw UserError("-velocity_file " + text +
+                      ": a file pattern takes one integer conversion (%d, %4d or %04d) and no "
+                      "other '%'");
+    at = i;
+    len = j + 1 - i;
+  }
+  return {at, len};
+}
+
+// PATTERN -> the comma list of the files it names for 0, 1, 2, ... (or from 1 when 0 is
+// missing), up to the first missing index (rank 0). Throws UserError when none exists.
+std::string expand_pattern(const std::string& text, const std::string& base_dir,
+                           std::pair<size_t, size_t> conv) {
+  const std::string fmt = text.substr(conv.first, conv.second);
+  auto name = [&](int i) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, fmt.c_str(), i);
+    return text.substr(0, conv.first) + buf + text.substr(conv.first + conv.second);
+  };
+  auto exists = [&](int i) {
+    std::error_code ec;
+    return std::filesystem::exists(resolve(base_dir, name(i)), ec);
+  };
+  const int first = exists(0) ? 0 : 1;
+  std::string list;
+  for (int i = first; i < first + 100000 && exists(i); ++i)
+    list += (list.empty() ? "" : ",") + name(i);
+  if (list.empty())
+    throw UserError("-velocity_file " + text + ": no file matches (looked for " + name(0) +
+                    " and " + name(1) + (base_dir.empty() ? "" : " in " + base_dir + " and") +
+                    " in the working directory)");
+  return list;
+}
+
 void bcast_frames(MPI_Comm comm, std::vector<VelocityFrame>& frames) {
   int count = static_cast<int>(frames.size());
   MPI_Bcast(&count, 1, MPI_INT, 0, comm);
@@ -132,8 +177,22 @@ void bcast_frames(MPI_Comm comm, std::vector<VelocityFrame>& frames) {
 } // namespace
 
 std::vector<VelocityFrame> read_velocity_frames(MPI_Comm comm, Options& opt,
-                                                const std::string& text,
+                                                const std::string& given,
                                                 const std::string& base_dir) {
+  const auto conv = pattern_conversion(given);
+  std::string text = given;
+  if (conv.first != std::string::npos) { // a numbered sequence of files
+    int rank = 0;
+    MPI_Comm_rank(comm, &rank);
+    std::string err;
+    if (rank == 0) try {
+        text = expand_pattern(given, base_dir, conv);
+      } catch (const UserError& e) {
+        err = e.what();
+      }
+    throw_if_any(comm, err);
+    bcast_string(comm, text);
+  }
   const bool series = ends_with(text, ".series");
   const bool list = !series && text.find(',') != std::string::npos;
   if (!list)

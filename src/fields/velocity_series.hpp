@@ -6,6 +6,8 @@
 //                  file) or else from a numeric attribute in each file,
 //                  -velocity_time_attribute /object/name (default /morphogen/time, the time of
 //                  a morphogen snapshot);
+//   PATTERN        a printf integer pattern (flow_%04d.h5): the files for 0, 1, 2, ... (from 1
+//                  when 0 is missing) up to the first missing index, then as a comma list;
 //   PATH           one file: a steady velocity.
 // Relative paths are looked up in the deck's directory first, then the working directory.
 // Times must be finite and strictly increasing. Bad input is a one-line UserError naming the
@@ -28,7 +30,7 @@ struct VelocityFrame {
 // Collective: rank 0 reads the series file / attributes, the frames are broadcast. Reads
 // -velocity_times and -velocity_time_attribute (comma lists only; refused otherwise).
 std::vector<VelocityFrame> read_velocity_frames(MPI_Comm comm, Options& opt,
-                                                const std::string& text,
+                                                const std::string& given,
                                                 const std::string& base_dir);
 
 // Index lo and weight w of time t between frames: u(t) = (1 - w) u_lo + w u_{lo+1}, w in

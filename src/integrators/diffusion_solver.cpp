@@ -13,7 +13,8 @@
 namespace morphogen {
 
 DiffusionSolver::DiffusionSolver(const Grid& grid, const OperatorMatrices& ops,
-                                 const std::vector<std::string>& species, Options& opt)
+                                 const std::vector<std::string>& species, Options& opt,
+                                 const std::vector<std::string>& varying)
     : grid_(grid), ops_(ops), species_(species) {
   const size_t ns = species.size();
   A_.resize(ns);
@@ -38,10 +39,12 @@ DiffusionSolver::DiffusionSolver(const Grid& grid, const OperatorMatrices& ops,
       opt.choice("diffusion_solver", "auto", {"auto", "ksp", "spectral"},
                  "diffusion substep solver: spectral (exact FFT/DCT solve; periodic "
                  "or zero-flux axes, constant coefficients), ksp, or auto (spectral where it "
-                 "applies and no -diffusion_ksp_*/-diffusion_pc_* option is given)"));
+                 "applies and no -diffusion_ksp_*/-diffusion_pc_* option is given)"),
+      varying);
 }
 
-void DiffusionSolver::choose_spectral(const std::string& mode) {
+void DiffusionSolver::choose_spectral(const std::string& mode,
+                                      const std::vector<std::string>& varying) {
   const int ns = ops_.nspecies();
   spectral_.resize(ns);
   spectral_mat_.assign(ns, nullptr);
@@ -64,6 +67,8 @@ void DiffusionSolver::choose_spectral(const std::string& mode) {
       why = "-diffusion_solver ksp";
     else if (mode == "auto" && user_ksp)
       why = "a -diffusion_ksp_/-diffusion_pc_ option was given";
+    else if (static_cast<size_t>(s) < varying.size() && !varying[s].empty())
+      why = varying[s] + ", re-assembled during the run";
     else if (!ops_.symmetric(s))
       why = "a non-symmetric operator";
     else

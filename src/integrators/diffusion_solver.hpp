@@ -19,8 +19,10 @@
 // constant-coefficient stencil on periodic / zero-flux axes (checked numerically,
 // operators/spectral_solver.hpp) is solved exactly by FFT/DCT instead, on any number of ranks
 // (auto: wherever it applies and no -diffusion_ksp_*/-diffusion_pc_* option is given, else KSP;
-// spectral: an error where it does not apply). A species whose matrix is later re-assembled
-// (operator_changed) or modified goes back to KSP. The choice per species is printed at setup.
+// spectral: an error where it does not apply). A species whose matrix is known at setup to be
+// re-assembled during the run (`varying`: coefficients using t or the state) gets KSP under
+// auto and is an error under spectral; one re-assembled otherwise (operator_changed) goes back
+// to KSP. The choice per species is printed at setup.
 #pragma once
 
 #include "core/options.hpp"
@@ -39,9 +41,11 @@ namespace morphogen {
 
 class DiffusionSolver {
 public:
-  // ops: the species' diffusion operators as matrices (kept by reference).
+  // ops: the species' diffusion operators as matrices (kept by reference). varying: per species,
+  // why its matrix will be re-assembled during the run ("" or missing: it will not).
   DiffusionSolver(const Grid& grid, const OperatorMatrices& ops,
-                  const std::vector<std::string>& species, Options& opt);
+                  const std::vector<std::string>& species, Options& opt,
+                  const std::vector<std::string>& varying = {});
   DiffusionSolver(const DiffusionSolver&) = delete;
   DiffusionSolver& operator=(const DiffusionSolver&) = delete;
 
@@ -63,7 +67,7 @@ public:
 
 private:
   void configure(int s);
-  void choose_spectral(const std::string& mode);
+  void choose_spectral(const std::string& mode, const std::vector<std::string>& varying);
   bool use_spectral(int s);
   void prepare_species(int s, double dt, double theta);
 

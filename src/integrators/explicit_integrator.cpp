@@ -114,7 +114,7 @@ void ExplicitIntegrator::use_terms(const TermList& terms) {
 }
 
 void ExplicitIntegrator::step(std::vector<VecH>& u, double t, double dt, PetscInt /*step*/) {
-  if (work_.empty())
+  if (work_.empty() && !in_place())
     for (int s = 0; s < ns_; ++s)
       work_.push_back(grid_.create_local());
   // Coefficients and Dirichlet values using t: at the step's start (before the ghosts take the
@@ -123,7 +123,7 @@ void ExplicitIntegrator::step(std::vector<VecH>& u, double t, double dt, PetscIn
   update_ghosts(u);
   if (terms_) terms_->refresh(u); // solution-dependent diffusion: coefficients of u^n
   if (others_.empty()) {
-    sweep(u, work_, dt);
+    sweep(u, in_place() ? nullptr : &work_, dt);
     if (constrain_after_sweep_) terms_->constrain(u);
     return;
   }
@@ -147,7 +147,7 @@ void ExplicitIntegrator::step(std::vector<VecH>& u, double t, double dt, PetscIn
   for (int s = 0; s < ns_; ++s)
     MG_PETSC(VecRestoreArrayRead(u[s], &in[s]));
   if (error) std::rethrow_exception(error);
-  sweep(u, work_, dt);
+  sweep(u, in_place() ? nullptr : &work_, dt);
   add_other_terms(u, t, dt);
 }
 
@@ -215,26 +215,54 @@ void ExplicitIntegrator::steps(std::vector<VecH>& u, double t, double dt, int n)
 
 void ExplicitIntegrator::step(std::vector<VecH>& u, std::vector<VecH>& work, double dt) const {
   update_ghosts(u);
-  sweep(u, work, dt);
+  sweep(u, &work, dt);
 }
 
-void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>& work, double dt) const {
+bool ExplicitIntegrator::in_place() const {
+  return ops_.empty() && grid_.dim() == 2;
+}
+
+// In-place sweeps: the rows last read by row j are those of rows j - R .. j + R (R: the stencil's
+// reach in y), so the new row j - R can be written into u once row j is computed. New rows wait
+// in a ring of R + 1 row buffers per species.
+int ExplicitIntegrator::reach_y() const {
+  int r = 0;
+  for (int q = 0; q < rows_.nrows; ++q)
+    r = std::max(r, std::abs(rows_.off[q][0]));
+  return r;
+}
+
+double* ExplicitIntegrator::ring_row(int s, PetscInt j) const {
+  const size_t n = static_cast<size_t>(grid_.owned().m[0]), depth = reach_y() + 1;
+  if (ring_.size() != static_cast<size_t>(ns_) * depth * n)
+    ring_.assign(static_cast<size_t>(ns_) * depth * n, 0.0);
+  return ring_.data() + (static_cast<size_t>(s) * depth + static_cast<size_t>(j) % depth) * n;
+}
+
+// Copies the new row j (owned part, 2-D) from the ring into u.
+void ExplicitIntegrator::commit_row(const std::vector<PetscScalar*>& u, PetscInt j) const {
+  const Box& ob = grid_.owned();
+  for (int s = 0; s < ns_; ++s)
+    std::copy_n(ring_row(s, j), ob.m[0], u[s] + grid_.local_index(ob.s[0], j, ob.s[2]));
+}
+
+void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, double dt) const {
   if (params_.any_field()) // scalars may have changed (parameters using t)
     params_.expand_scalars(static_cast<size_t>(grid_.owned().m[0]), const_rows_);
   if (!ops_.empty()) {
-    step_general(u, work, dt);
+    step_general(u, *work, dt);
     return;
   }
   LogScope log_scope(log_events().sweep);
   const int nr = rows_.nrows;
   const int np = static_cast<int>(params_.scalar.size());
   const bool field_mode = params_.any_field();
-  std::vector<const PetscScalar*> in(ns_);
-  std::vector<PetscScalar*> out(ns_);
+  const bool in_place = work == nullptr; // 2-D only (in_place())
+  std::vector<PetscScalar*> in(ns_), out(ns_);
   std::vector<const PetscScalar*> pf(np, nullptr);
   for (int s = 0; s < ns_; ++s) {
-    MG_PETSC(VecGetArrayRead(u[s], &in[s]));
-    MG_PETSC(VecGetArray(work[s], &out[s]));
+    MG_PETSC(VecGetArray(u[s], &in[s]));
+    if (!in_place) MG_PETSC(VecGetArray((*work)[s], &out[s]));
   }
   for (int q = 0; q < np; ++q)
     if (params_.field[q].get()) MG_PETSC(VecGetArrayRead(params_.field[q], &pf[q]));
@@ -263,6 +291,7 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>& work, do
   // In 3-D, sweep the box in blocks of y rows so that the three z planes a row reads stay in
   // the per-core L2 cache (about 256 KiB of state per block); in 2-D one block is the box.
   PetscInt jblock = ob.m[1];
+  const int reach = reach_y();
   if (grid_.dim() == 3) {
     const PetscInt bytes_per_row = 3 * ns_ * gx * static_cast<PetscInt>(sizeof(double));
     jblock = std::max<PetscInt>(4, (256 * 1024) / bytes_per_row - 2);
@@ -274,7 +303,7 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>& work, do
         for (int s = 0; s < ns_; ++s) {
           for (int r = 0; r < nr; ++r)
             src[s * nr + r] = in[s] + c + delta[r];
-          dst[s] = out[s] + c;
+          dst[s] = in_place ? ring_row(s, j) : out[s] + c;
         }
         if (field_mode) {
           const PetscInt o = grid_.owned_index(ob.s[0], j, k);
@@ -282,15 +311,19 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>& work, do
             prow[q] = pf[q] ? pf[q] + o : const_rows_[q].data();
         }
         row_fn_(row);
+        if (in_place && j - reach >= ob.s[1]) commit_row(in, j - reach);
       }
+  if (in_place)
+    for (PetscInt j = std::max(ob.s[1], ob.s[1] + ob.m[1] - reach); j < ob.s[1] + ob.m[1]; ++j)
+      commit_row(in, j);
 
   for (int q = 0; q < np; ++q)
     if (pf[q]) MG_PETSC(VecRestoreArrayRead(params_.field[q], &pf[q]));
   for (int s = 0; s < ns_; ++s) {
-    MG_PETSC(VecRestoreArrayRead(u[s], &in[s]));
-    MG_PETSC(VecRestoreArray(work[s], &out[s]));
+    MG_PETSC(VecRestoreArray(u[s], &in[s]));
+    if (!in_place) MG_PETSC(VecRestoreArray((*work)[s], &out[s]));
   }
-  std::swap(u, work);
+  if (!in_place) std::swap(u, *work);
 }
 
 } // namespace morphogen

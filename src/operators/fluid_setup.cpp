@@ -53,6 +53,18 @@ void register_ksp_options(Options& opt) {
       opt.known(std::string(p) + k);
 }
 
+// A cavity's or channel's walls bound the grid: a periodic axis would let the species wrap
+// through a wall (or from the channel's outflow back to its inflow).
+void check_walls(const Grid& grid, const std::string& option_text) {
+  const auto& bc = grid.spec().bc;
+  if (bc[0] != Boundary::Periodic && bc[1] != Boundary::Periodic) return;
+  throw UserError(option_text + " with -grid_bc " + boundary_name(bc[0]) + "," +
+                  boundary_name(bc[1]) +
+                  ": the flow has walls (or inflow and outflow) on x and y, so neither axis may be "
+                  "periodic; allowed: "
+                  "-grid_bc neumann or dirichlet on both axes (or -fluid periodic)");
+}
+
 } // namespace
 
 std::unique_ptr<FluidSolver> read_fluid(Options& opt, const Grid& grid, std::uint64_t seed,
@@ -75,6 +87,7 @@ std::unique_ptr<FluidSolver> read_fluid(Options& opt, const Grid& grid, std::uin
   if (grid.dim() != 2)
     throw UserError(s.option_text + ": the fluid solver is 2-D only (the grid is " +
                     std::to_string(grid.dim()) + "-D; use a 2-D -grid_n nx,ny)");
+  if (s.kind != fluid::Kind::Periodic) check_walls(grid, s.option_text);
   s.viscosity = opt.real("fluid_viscosity", 0.01, 0.0, Options::inf,
                          "kinematic viscosity nu of the fluid (implicit; 0: inviscid)");
   if (s.kind == fluid::Kind::Cavity)

@@ -12,6 +12,7 @@ GRID = ["-grid_n", "16,16", "-steps", "2"]
 DYE = ["-model", "custom", "-species", "dye", "-rate_dye", "0", "-D_dye", "0", "-grid_L", "1",
        "-grid_bc", "neumann", "-init_dye", "x", "-advect", "dye", "-dt", "0.01"]
 CAVITY = DYE + ["-fluid", "cavity"]
+CAVITY_PERIODIC = [a if a != "neumann" else "periodic" for a in DYE]
 OBSTACLE = CAVITY + ["-fluid_obstacle", "disk(0.5, 0.5, 0.2)"]
 
 CASES = [
@@ -53,13 +54,45 @@ CASES = [
     ("hex_in_list", ["-png_range_a", "0x10,20"], ["-png_range_a 0x10", "not a number"]),
     ("trailing_comma", ["-grid_n", "16,16,"], ["-grid_n", "not an integer"]),
     ("trailing_comma_bc", ["-grid_bc", "periodic,"], ["-grid_bc"]),
+    # An explicit -diffusion_solver spectral that cannot be honoured (used to fall back to KSP).
+    ("spectral_timed_D", ["-integrator", "split", "-diffusion_solver", "spectral",
+                          "-D_a", "1 + 0.1*t"],
+     ["-diffusion_solver spectral: species a", "its coefficients use t (-D_a",
+      "allowed here: ksp or auto"]),
+    ("spectral_polar", ["-integrator", "split", "-diffusion_solver", "spectral",
+                        "-diffusion_a", "polar"],
+     ["-diffusion_solver spectral: species a", "follow the state (-diffusion_a polar",
+      "allowed here: ksp or auto"]),
+    ("spectral_pinned", ["-integrator", "split", "-diffusion_solver", "spectral",
+                         "-pin_a", "j < 2"],
+     ["-diffusion_solver spectral: species a", "allowed here: ksp or auto"]),
+    ("spectral_varying_D", ["-integrator", "split", "-diffusion_solver", "spectral",
+                            "-D_b", "1 + x/16"],
+     ["-diffusion_solver spectral: species b", "allowed here: ksp or auto"]),
+    # Wall-bounded flows on a periodic axis.
+    ("cavity_periodic", CAVITY_PERIODIC + ["-fluid", "cavity"],
+     ["-fluid cavity with -grid_bc periodic,periodic", "neither axis may be periodic",
+      "allowed: -grid_bc neumann or dirichlet on both axes"]),
+    ("channel_periodic_y", CAVITY_PERIODIC + ["-grid_bc", "neumann,periodic", "-fluid", "channel"],
+     ["-fluid channel with -grid_bc neumann,periodic", "neither axis may be periodic"]),
+    # Log files that cannot be written: refused before the run, not in PetscFinalize.
+    ("log_view_no_dir", ["-log_view", ":/nonexistent/dir/file.txt"],
+     ["-log_view :/nonexistent/dir/file.txt", "directory /nonexistent/dir does not exist",
+      "allowed: -log_view [ascii][:FILE[:FORMAT]]"]),
+    ("log_view_bad_format", ["-log_view", ":log.txt:bogus"],
+     ["-log_view :log.txt:bogus", "format 'bogus'", "ascii_info_detail"]),
+    ("log_view_type", ["-log_view", "log.txt"],
+     ["-log_view log.txt", "viewer type 'log.txt'", "allowed: -log_view [ascii]"]),
+    ("log_trace_no_dir", ["-log_trace", "/nonexistent/dir/trace"],
+     ["-log_trace /nonexistent/dir/trace", "does not exist", "allowed: -log_trace [PREFIX]"]),
 ]
 
 
 # Every case on 1 rank; on 2 ranks those whose check involves parallel code (reductions over
 # the grid, PETSc's parallel solvers, MPI-IO file names), to keep the suite short.
 TWO_RANKS = {"courant_overflow", "obstacle_everywhere", "output_name_long", "mg_without_galerkin",
-             "ts_mg_without_galerkin", "fluid_mg_levels", "stray_word"}
+             "ts_mg_without_galerkin", "fluid_mg_levels", "stray_word", "spectral_timed_D",
+             "cavity_periodic", "log_view_no_dir", "log_trace_no_dir"}
 RUNS = [(c, 1) for c in CASES] + [(c, 2) for c in CASES if c[0] in TWO_RANKS]
 
 
@@ -105,3 +138,22 @@ def test_preonly_direct_solve_runs(what, ranks, workdir):
             finals.append(f["VTKHDF/PointData/" + name][()].ravel())
     scale = max(1.0, float(abs(finals[0]).max()))
     assert float(abs(finals[0] - finals[1]).max()) <= 1e-6 * scale
+
+
+# -diffusion_solver auto with a D using t: KSP for that species, chosen (and said) at setup;
+# the other species keeps the spectral solve.
+def test_auto_timed_diffusion_uses_ksp(workdir):
+    proc = run(GRID + ["-integrator", "split", "-D_a", "1 + 0.1*t", "-output_dir",
+                       str(workdir / "out"), "-summary", "false"], cwd=workdir, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    assert "diffusion solve of a: ksp (its coefficients use t" in proc.stdout, proc.stdout
+    assert "diffusion solve of b: spectral" in proc.stdout, proc.stdout
+    assert "its matrix changed" not in proc.stdout
+
+
+# A writable -log_view file is written as before.
+def test_log_view_file_written(workdir):
+    proc = run(GRID + ["-log_view", ":lv.txt:ascii_info_detail", "-output_dir",
+                       str(workdir / "out"), "-summary", "false"], cwd=workdir, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    assert (workdir / "lv.txt").stat().st_size > 1000

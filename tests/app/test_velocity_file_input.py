@@ -65,6 +65,8 @@ def files(tmp_path):
     bad["velocity_y"][5, 3] = np.nan
     write(d / "nan.h5", bad)
     (d / "text.h5").write_text("not hdf5\n")
+    for i, t in ((1, 0.0), (2, 1.5), (3, 4.0)):
+        write(d / f"flow_{i:04d}.h5", shear(0.5 * i), time=t)
     series(d / "same_t.series", [("ok.h5", 1.0), ("ok.h5", 1.0)])
     series(d / "outgrow.series", [("ok.h5", 0.0), ("fast.h5", 10.0)])
     series(d / "outgrow_widest.series", [("ok.h5", 0.0), ("faster.h5", 10.0)])
@@ -105,6 +107,12 @@ CASES = [
      ["-velocity_x", "-velocity_file IN/ok.h5", "drop -velocity_x or -velocity_file"]),
     ("with_fluid", ["-velocity_file", "IN/ok.h5", "-fluid", "cavity", "-grid_bc", "neumann"],
      ["-velocity_file IN/ok.h5", "-fluid cavity", "drop -velocity_file or the fluid"]),
+    ("pattern_bad_conversion", ["-velocity_file", "IN/flow_%s.h5"],
+     ["-velocity_file IN/flow_%s.h5", "one integer conversion (%d, %4d or %04d)"]),
+    ("pattern_two_conversions", ["-velocity_file", "IN/flow_%d_%d.h5"],
+     ["-velocity_file IN/flow_%d_%d.h5", "one integer conversion"]),
+    ("pattern_no_match", ["-velocity_file", "IN/none_%03d.h5"],
+     ["-velocity_file IN/none_%03d.h5", "no file matches", "none_000.h5", "none_001.h5"]),
     ("datasets_without_file", EXPR + ["-velocity_datasets", "u,v"],
      ["-velocity_datasets", "applies with -velocity_file only"]),
     # Frame 2 (t = 10, never reached in 6 steps) has max |u_x| = 77.5: Courant 38.75.
@@ -200,3 +208,16 @@ def test_deck_keys_and_deck_directory(files, tmp_path):
     assert np.array_equal(final_a(out), final_a(tmp_path / "expr"))
     used = (out / "options_used.yaml").read_text()
     assert 'velocity_file: "ok.h5"' in used and 'velocity_datasets: "velocity_x,velocity_y"' in used
+
+
+def test_numbered_pattern_equals_comma_list(files, tmp_path):
+    """-velocity_file flow_%04d.h5 reads flow_0001..0003 (0 is missing; 4 ends the sequence),
+    exactly as the comma list of the three files (times from their /morphogen/time)."""
+    names = ",".join(str(files / f"flow_{i:04d}.h5") for i in (1, 2, 3))
+    run_ok(["-velocity_file", names], tmp_path / "list", tmp_path)
+    proc = run_ok(["-velocity_file", str(files / "flow_%04d.h5")], tmp_path / "pattern",
+                  tmp_path)
+    assert "3 frames, t in [0, 4]" in proc.stdout, proc.stdout
+    a = final_a(tmp_path / "pattern")
+    assert np.ptp(a) > 0.1
+    assert np.array_equal(a, final_a(tmp_path / "list"))
