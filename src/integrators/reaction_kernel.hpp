@@ -21,11 +21,14 @@
 // decrease ||F||_2^2 by the Armijo factor (1 - 2e-4 lambda), the step is halved (at most 10
 // times); if no fraction helps, the full step is taken. Near the root this is plain Newton
 // (quadratic); far from it, it roughly halves the failures of undamped Newton at dt >> 1/||J||.
-// Convergence (scale-aware, affine-invariant): with scale = 1 + max(||u||_inf, ||v||_inf),
-//   converged  <=>  ||dv||_inf <= tol * scale   for the full (undamped) update dv that gave v.
-// The update is Newton's estimate of the error of the previous iterate, so the returned v (one
-// step further) is accurate to ~tol^2 in the quadratic regime; the "1 +" makes tol absolute for
-// concentrations below 1 and relative above. The residual ||F(v)||_inf is reported but not
+// Convergence (scale-aware, affine-invariant): with scale = 1 + max(||u||_inf, ||v||_inf), for
+// the full (undamped) update dv that gave v and the full update dv' before it (if any),
+//   converged  <=>  ||dv||_inf <= tol * scale, or
+//                   theta / (1 - theta) ||dv||_inf <= tol * scale,  theta = ||dv|| / ||dv'|| < 1
+// (Hairer-Wanner's estimate of the error left in v, assuming only linear convergence; in the
+// quadratic regime it overestimates that error by 1/theta, so the returned v is accurate to far
+// below tol, and the test saves the last, confirming iteration). The "1 +" makes tol absolute
+// for concentrations below 1 and relative above. The residual ||F(v)||_inf is reported but not
 // tested: for large dt, F ~ dt R(v) carries round-off of order eps dt |terms of R|, which can
 // exceed any fixed tolerance on F although v is exact to working precision (a stiff cell), while
 // the update stays a faithful error measure. tol should be well above machine epsilon (1e-13 or
@@ -145,6 +148,20 @@ template <int N> inline bool lu_solve(double* A, double* b) {
   return true;
 }
 
+// The convergence test of the header comment after a full Newton update of size `step`, the
+// previous full update `prev` (0: none) and bound = tol * scale; branch-free (the lockstep
+// kernel applies it per lane): step <= bound, or step^2 <= (prev - step) bound, which for
+// prev > 0 is theta / (1 - theta) step <= bound with theta = step / prev < 1.
+inline double newton_converged_mask(double step, double prev, double bound) {
+  const double plain = step <= bound ? 1.0 : 0.0;
+  const double estimate = step * step <= (prev - step) * bound ? 1.0 : 0.0;
+  return plain > estimate ? plain : estimate;
+}
+
+inline bool newton_converged(double step, double prev, double bound) {
+  return newton_converged_mask(step, prev, bound) != 0.0;
+}
+
 } // namespace detail
 
 // One cell: see the header comment. u, S0, S1 and v have M::nspecies entries (S0/S1 may be
@@ -226,6 +243,7 @@ inline CellSolve reaction_cell_of(const Model& m, ReactionScheme scheme, const d
   // taken, so this is never worse than plain Newton, and near the root it is plain Newton.
   double J[NS * NS], dv[NS], vt[NS], Ft[NS];
   const double big_step = std::sqrt(tol);
+  double prev = 0.0; // the previous full update's size (0: none)
   for (int it = 1; it <= maxit; ++it) {
     m.jacobian(v, p, J);
     for (int q = 0; q < NS * NS; ++q)
@@ -261,10 +279,11 @@ inline CellSolve reaction_cell_of(const Model& m, ReactionScheme scheme, const d
     }
     out.residual = res;
     if (!std::isfinite(res)) return out; // also catches a non-finite v (F contains v)
-    if (lam == 1.0 && step <= tol * detail::scale<NS>(unorm, v)) {
+    if (lam == 1.0 && detail::newton_converged(step, prev, tol * detail::scale<NS>(unorm, v))) {
       out.converged = true;
       return out;
     }
+    prev = lam == 1.0 ? step : 0.0;
   }
   return out;
 }

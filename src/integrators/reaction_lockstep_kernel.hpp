@@ -6,8 +6,9 @@
 //   Trapezoidal    F(v) = v - u - dt/2 (R(u) + S0 + R(v) + S1)       = 0
 // started from the better of u and the explicit Euler predictor, full Newton steps
 //   (I - c dt dR/du(v)) dv = -F(v),  v <- v + dv,
-// converged when ||dv||_inf <= tol (1 + max(||u||_inf, ||v||_inf)), but solved for W = 16 cells
-// of a row at once, held as structure-of-arrays (one array per species/state over the lanes):
+// converged by reaction_kernel.hpp's test (||dv||_inf <= tol (1 + max(||u||_inf, ||v||_inf)) or
+// the contraction estimate from the previous update, newton_converged_mask), but solved for W = 16
+// cells of a row at once, held as structure-of-arrays (one array per species/state over the lanes):
 // the start and each Newton step is one loop over the lanes with no branches - 0/1 masks held
 // as doubles, selects, no early exit per lane - so GCC vectorises it (-fopt-info-vec reports
 // "loop vectorized" for lockstep_start and lockstep_newton; 512-bit vectors where the target
@@ -94,7 +95,7 @@ template <int N> inline bool cramer_solve(const double* A, const double* b, doub
 // flags as doubles so that every select vectorises).
 template <int NS, int NP, int W> struct LockstepLanes {
   double u[NS][W], s0[NS][W], s1[NS][W], p[NP][W];
-  double base[NS][W], v[NS][W], F[NS][W], unorm[W], res[W], its[W], done[W], bad[W];
+  double base[NS][W], v[NS][W], F[NS][W], unorm[W], res[W], its[W], done[W], bad[W], prev[W];
 };
 
 // Start: base, the better of u and the Euler predictor, its residual; lanes with a non-finite
@@ -141,6 +142,7 @@ MG_LOCKSTEP_WIDE inline void lockstep_start(LockstepLanes<NS, NP, W>& L, double 
     L.res[l] = res;
     L.unorm[l] = un;
     L.its[l] = 0.0;
+    L.prev[l] = 0.0;
     L.bad[l] = bad;
     L.done[l] = bad == 0.0 && res == 0.0 ? 1.0 : 0.0;
   }
@@ -196,8 +198,8 @@ MG_LOCKSTEP_WIDE inline void lockstep_newton(LockstepLanes<NS, NP, W>& L, double
     const double act = (1.0 - L.done[l]) * (1.0 - L.bad[l]);
     const double ok = regular * finite_mask(fin) * (1.0 - far * (1.0 - armijo));
     const double take = act * ok;
-    const double conv = step <= tol * (1.0 + (un > vtn ? un : vtn)) ? 1.0 : 0.0;
-    const double res0 = L.res[l], its0 = L.its[l];
+    const double conv = newton_converged_mask(step, L.prev[l], tol * (1.0 + (un > vtn ? un : vtn)));
+    const double res0 = L.res[l], its0 = L.its[l], prev0 = L.prev[l];
 #pragma GCC unroll 16
     for (int s = 0; s < NS; ++s) {
       const double F0 = -rhs[s];
@@ -206,6 +208,7 @@ MG_LOCKSTEP_WIDE inline void lockstep_newton(LockstepLanes<NS, NP, W>& L, double
     }
     L.res[l] = take != 0.0 ? rest : res0;
     L.its[l] = take != 0.0 ? it : its0;
+    L.prev[l] = take != 0.0 ? step : prev0;
     L.bad[l] += act * (1.0 - ok);
     L.done[l] += take * conv;
   }

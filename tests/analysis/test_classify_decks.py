@@ -33,6 +33,7 @@ EXPECTED = {
     "gray_scott_pearson_spots": {"a": "spots"},                 # Pearson's self-replicating spots
     "barkley_spiral": {"A": "oscillating"},                     # a rotating spiral
     "brusselator": {"b": "spots"},                              # hexagonal spots
+    "cavity_gray_scott_replay": {"a": "labyrinth"},  # stable-ARD Fig. 5, flow from a file: one wound band
     "brusselator_fixed_rows": {"a": "stripes", "b": "stripes"},  # Fig. 20 left: pinned rows
     "brusselator_spot_on_spot": {"b1": "spots", "b2": "spots"},  # Fig. 10: coupled layers
     "brusselator_aligned_spots": {"a2": "stripes", "b2": "stripes"},  # Fig. 21: aligned by mu
