@@ -23,14 +23,17 @@ namespace morphogen {
 
 class FieldSampler {
 public:
-  // Collective: appends one sample of every species.
+  // only >= 0: sample that species alone (the others' samples stay empty).
+  explicit FieldSampler(int only = -1) : only_(only) {}
+  // Collective: appends one sample of every species (or of `only`).
   void take(Simulation& sim);
   const analysis::RunSamples& samples(int species) const { return samples_[species]; }
-  size_t count() const { return samples_.empty() ? 0 : samples_[0].t.size(); }
+  size_t count() const { return samples_.empty() ? 0 : samples_[only_ >= 0 ? only_ : 0].t.size(); }
 
 private:
   std::vector<analysis::RunSamples> samples_;
   std::vector<std::vector<double>> prev_;
+  int only_ = -1;
 };
 
 // Collective. On rank 0: {"class", "reason", "metrics", "dynamics"}; elsewhere null.

@@ -640,6 +640,13 @@ void Simulation::read_fuse(Options& opt) {
       "explicit steps fused per pass over the grid (temporal blocking: a k-cell halo exchanged "
       "once per k steps; 2-D periodic fast path, else 1; results bitwise those of 1)");
   integrator_->set_fuse_steps(static_cast<int>(k));
+  const std::string in_place = opt.choice(
+      "explicit_in_place", "auto", {"auto", "yes", "no"},
+      "2-D fast path: update the state in place, with no second state set (8 bytes per cell and "
+      "species less); auto: where a rank's state is at least 8 MiB; the same results");
+  integrator_->set_in_place(in_place == "yes"  ? ExplicitIntegrator::InPlace::Always
+                            : in_place == "no" ? ExplicitIntegrator::InPlace::Never
+                                               : ExplicitIntegrator::InPlace::Auto);
   const std::string why = fuse_blocker(integrator_->fuse_unsupported());
   fuse_ = why.empty() ? k : 1;
   if (k > 1 && !why.empty())

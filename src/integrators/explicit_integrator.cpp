@@ -17,6 +17,8 @@ ExplicitIntegrator::ExplicitIntegrator(const Grid& grid, const Halo& halo, RowFn
       floor_(std::move(floor)), params_(params), dirichlet_(dirichlet) {
   to_rows(stencil_, rows_);
   by_class_ = box_classes(rows_, classes_); // 19pt, 27pt: weight classes, rows in class order
+  ring_depth_ = reach_y() + 1;
+  ring_n_ = static_cast<size_t>(grid.owned().m[0]);
   if (params_.any_field())
     params_.expand_scalars(static_cast<size_t>(grid.owned().m[0]), const_rows_);
 }
@@ -219,7 +221,9 @@ void ExplicitIntegrator::step(std::vector<VecH>& u, std::vector<VecH>& work, dou
 }
 
 bool ExplicitIntegrator::in_place() const {
-  return ops_.empty() && grid_.dim() == 2;
+  if (!ops_.empty() || grid_.dim() != 2 || in_place_ == InPlace::Never) return false;
+  const double bytes = 8.0 * ns_ * static_cast<double>(grid_.owned().size());
+  return in_place_ == InPlace::Always || bytes >= kInPlaceBytes;
 }
 
 // In-place sweeps: the rows last read by row j are those of rows j - R .. j + R (R: the stencil's
@@ -230,13 +234,6 @@ int ExplicitIntegrator::reach_y() const {
   for (int q = 0; q < rows_.nrows; ++q)
     r = std::max(r, std::abs(rows_.off[q][0]));
   return r;
-}
-
-double* ExplicitIntegrator::ring_row(int s, PetscInt j) const {
-  const size_t n = static_cast<size_t>(grid_.owned().m[0]), depth = reach_y() + 1;
-  if (ring_.size() != static_cast<size_t>(ns_) * depth * n)
-    ring_.assign(static_cast<size_t>(ns_) * depth * n, 0.0);
-  return ring_.data() + (static_cast<size_t>(s) * depth + static_cast<size_t>(j) % depth) * n;
 }
 
 // Copies the new row j (owned part, 2-D) from the ring into u.
@@ -258,6 +255,7 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
   const int np = static_cast<int>(params_.scalar.size());
   const bool field_mode = params_.any_field();
   const bool in_place = work == nullptr; // 2-D only (in_place())
+  if (in_place) ring_.resize(static_cast<size_t>(ns_) * ring_depth_ * ring_n_);
   std::vector<PetscScalar*> in(ns_), out(ns_);
   std::vector<const PetscScalar*> pf(np, nullptr);
   for (int s = 0; s < ns_; ++s) {
@@ -291,7 +289,7 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
   // In 3-D, sweep the box in blocks of y rows so that the three z planes a row reads stay in
   // the per-core L2 cache (about 256 KiB of state per block); in 2-D one block is the box.
   PetscInt jblock = ob.m[1];
-  const int reach = reach_y();
+  const int reach = ring_depth_ - 1;
   if (grid_.dim() == 3) {
     const PetscInt bytes_per_row = 3 * ns_ * gx * static_cast<PetscInt>(sizeof(double));
     jblock = std::max<PetscInt>(4, (256 * 1024) / bytes_per_row - 2);

@@ -5,17 +5,16 @@
 // The driver owns communication: halo update of every species (begin all, end all, then the
 // physical boundaries), then one pass over the owned box calling the model's fused row kernel
 // (explicit_kernel.hpp) for each grid row. State lives in ghosted local Vecs. In 2-D the fast
-// path updates them in place: each new row waits in a ring of R + 1 row buffers (R: the
-// stencil's reach in y) until the rows reading it are done, so there is no second state set
-// (8 bytes per cell and species less) and the sweep moves 16 bytes per cell and species (no
-// write-allocate of a second array). Otherwise (3-D, the general path, fused steps) the new
-// state is written into a second set, and the two are swapped (no global-to-local copy).
-// The step is stable for dt <= 2 / (D_max * spectral_radius(L)) (the diffusion bound,
-// dt <= h^2 / (2 dim D_max) for the 5/7-point Laplacian).
-// General path (any species with a diffusion field or tensor): per grid row, each species'
-// diffusion (DiffusionOperator::apply_row) goes into a row buffer, then the model's
-// explicit_row_pre adds the reaction and writes the row, so the tile stays in cache; stable for
-// dt <= 2 / max_s radius_s (lambda_max of the tensors over the grid).
+// path updates them in place where a rank's state is large (set_in_place): each new row waits in a
+// ring of R + 1 row buffers (R: the stencil's reach in y) until the rows reading it are done, so
+// there is no second state set (8 bytes per cell and species less) and the sweep moves 16 bytes per
+// cell and species (no write-allocate of a second array). Otherwise (3-D, the general path, fused
+// steps) the new state is written into a second set, and the two are swapped (no global-to-local
+// copy). The step is stable for dt <= 2 / (D_max * spectral_radius(L)) (the diffusion bound, dt <=
+// h^2 / (2 dim D_max) for the 5/7-point Laplacian). General path (any species with a diffusion
+// field or tensor): per grid row, each species' diffusion (DiffusionOperator::apply_row) goes into
+// a row buffer, then the model's explicit_row_pre adds the reaction and writes the row, so the tile
+// stays in cache; stable for dt <= 2 / max_s radius_s (lambda_max of the tensors over the grid).
 // Other terms of the run (sources, ...: use_terms) are evaluated on u^n after the halo update,
 // and dt times their rates is added after the sweep, followed by the run's constraints:
 //   u^{n+1} = C( sweep(u^n) + dt sum_k T_k(u^n, t) )
@@ -73,6 +72,13 @@ public:
   void use_operators(std::vector<const DiffusionOperator*> ops, PreFn pre_fn);
   bool general() const { return !ops_.empty(); }
 
+  // The 2-D fast path's in-place update (see the header comment): Auto where a rank's state is
+  // at least kInPlaceBytes (out of cache: the memory matters, the row copies hide behind the
+  // memory traffic), else a second state set; Always and Never force it (the same results).
+  enum class InPlace { Auto, Always, Never };
+  static constexpr double kInPlaceBytes = 8.0 * 1024 * 1024;
+  void set_in_place(InPlace mode) { in_place_ = mode; }
+
   // Temporal blocking: up to k >= 1 steps per pass (1: one step per pass, the default).
   void set_fuse_steps(int k) { fuse_request_ = k; }
   // Why this run cannot fuse steps ("" when it can).
@@ -87,9 +93,13 @@ public:
 private:
   // work == nullptr: in place (in_place()).
   void sweep(std::vector<VecH>& u, std::vector<VecH>* work, double dt) const;
-  bool in_place() const; // the fast path on a 2-D grid
+  bool in_place() const;
   int reach_y() const;
-  double* ring_row(int s, PetscInt j) const;
+  double* ring_row(int s, PetscInt j) const {
+    return ring_.data() + (static_cast<size_t>(s) * ring_depth_ +
+                           static_cast<size_t>(j) % static_cast<size_t>(ring_depth_)) *
+                              ring_n_;
+  }
   void commit_row(const std::vector<PetscScalar*>& u, PetscInt j) const;
   void add_other_terms(std::vector<VecH>& u, double t, double dt);
   void step_general(std::vector<VecH>& u, std::vector<VecH>& work, double dt) const;
@@ -110,10 +120,13 @@ private:
   PreFn pre_fn_;
   mutable std::vector<std::vector<double>> div_; // per species row buffer of the general path
   const TermList* terms_ = nullptr;
-  std::vector<const Term*> others_;        // terms evaluated through add_rates
-  bool constrain_after_sweep_ = false;     // constraints other than the kernel's clamp floor
-  std::vector<VecH> work_;                 // second state set (created when first needed)
-  mutable std::vector<double> ring_;       // in-place sweeps: [ns][R + 1][nx] new rows
+  std::vector<const Term*> others_;    // terms evaluated through add_rates
+  bool constrain_after_sweep_ = false; // constraints other than the kernel's clamp floor
+  std::vector<VecH> work_;             // second state set (created when first needed)
+  mutable std::vector<double> ring_;   // in-place sweeps: [ns][R + 1][nx] new rows
+  int ring_depth_ = 2;                 // R + 1
+  size_t ring_n_ = 0;                  // owned cells per row
+  InPlace in_place_ = InPlace::Auto;
   std::vector<std::vector<double>> rates_; // owned layout, per species (other terms)
   int fuse_request_ = 1;
   std::unique_ptr<FusedSweep> fused_; // built on the first fused call

@@ -41,7 +41,7 @@ nlohmann::json run_point_impl(const SweepSpec& spec, long long p, const SweepSet
           : static_cast<int>(std::find(names.begin(), names.end(), set.species) - names.begin());
 
   // Time loop with sampling; a diverged run is the class blowup, not an error.
-  FieldSampler sampler;
+  FieldSampler sampler(sm);
   const PetscInt steps = sim.steps();
   const PetscInt every = std::max<PetscInt>(1, steps / std::max<long long>(1, set.samples));
   std::string diverged;
