@@ -630,8 +630,9 @@ void Simulation::step() {
 void Simulation::read_fuse(Options& opt) {
   const char* key = "explicit_fuse_steps";
   if (split_ || ts_) {
-    if (opt.is_set(key))
-      throw UserError("-explicit_fuse_steps: applies to -integrator explicit only");
+    for (const char* k : {key, "explicit_in_place"})
+      if (opt.is_set(k))
+        throw UserError(std::string("-") + k + ": applies to -integrator explicit only");
     if (split_fuse_) read_split_fuse();
     return;
   }

@@ -57,3 +57,10 @@ def test_bad_value_is_one_line(tmp_path):
     p = run([DECK, "-grid_n", "16,16", "-steps", "1", "-explicit_in_place", "maybe"], tmp_path)
     assert p.returncode != 0
     assert "-explicit_in_place maybe" in p.stderr and "auto" in p.stderr, p.stderr
+
+
+def test_other_integrators_refuse_it(tmp_path):
+    p = run([DECK, "-grid_n", "16,16", "-steps", "1", "-integrator", "split",
+             "-explicit_in_place", "yes"], tmp_path)
+    assert p.returncode != 0
+    assert "-explicit_in_place: applies to -integrator explicit only" in p.stderr, p.stderr
