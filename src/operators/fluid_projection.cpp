@@ -86,25 +86,26 @@ std::unique_ptr<SpectralSolver> FluidSolver::spectral_for(Mat A, const std::stri
 }
 
 // rhs = -div(u_f) at the fluid cells (0 at solid cells); returns sum of div^2 over this rank.
+// face(o, d, s): the face of owned cell o on side s of axis d; solid: the ghosted solid mask.
 namespace {
-double divergence_rhs(const Grid& grid, const double* const u[2], double* rhs,
-                      const std::function<fluid::Face(PetscInt, PetscInt, int, int)>& face,
-                      const std::function<bool(PetscInt, PetscInt)>& solid) {
+template <class FaceOf>
+double divergence_rhs(const Grid& grid, const double* const u[2], double* rhs, const FaceOf& face,
+                      const double* solid) {
   const Box& ob = grid.owned();
   const double h[2] = {grid.spec().h(0), grid.spec().h(1)};
   double sum = 0.0;
   for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j)
     for (PetscInt i = ob.s[0]; i < ob.s[0] + ob.m[0]; ++i) {
       double div = 0.0;
-      const PetscInt c = grid.local_index(i, j, 0);
-      for (int d = 0; d < 2 && !solid(i, j); ++d)
+      const PetscInt c = grid.local_index(i, j, 0), o = grid.owned_index(i, j, 0);
+      for (int d = 0; d < 2 && !(solid[c] > 0.5); ++d)
         for (int s = -1; s <= 1; s += 2) {
           const PetscInt n = d == 0 ? grid.local_index(i + s, j, 0) : grid.local_index(i, j + s, 0);
-          const fluid::Face f = face(i, j, d, s);
+          const fluid::Face& f = face(o, d, s);
           const double un = f.proj == fluid::ProjFace::Open ? u[d][n] : 0.0;
           div += s * fluid::face_velocity(f, u[d][c], un) / h[d];
         }
-      rhs[grid.owned_index(i, j, 0)] = -div;
+      rhs[o] = -div;
       sum += div * div;
     }
   return sum;
@@ -126,14 +127,13 @@ void FluidSolver::solve_pressure_ksp() {
 void FluidSolver::project() {
   refresh(u_[0]);
   refresh(u_[1]);
-  auto facefn = [&](PetscInt i, PetscInt j, int d, int s) { return face(i, j, d, s); };
-  auto solidfn = [&](PetscInt i, PetscInt j) { return solid(i, j); };
+  auto faceof = [this](PetscInt o, int d, int s) -> const fluid::Face& { return face_of(o, d, s); };
   PetscScalar *ua, *va, *r;
   MG_PETSC(VecGetArray(u_[0], &ua));
   MG_PETSC(VecGetArray(u_[1], &va));
   const double* u[2] = {ua, va};
   MG_PETSC(VecGetArray(rhs_, &r));
-  double before = divergence_rhs(grid_, u, r, facefn, solidfn);
+  double before = divergence_rhs(grid_, u, r, faceof, solidv_.data());
   MG_PETSC(VecRestoreArray(rhs_, &r));
   if (null_) MG_PETSC(MatNullSpaceRemove(null_, rhs_));
   if (spectral_pois_) {
@@ -155,8 +155,8 @@ void FluidSolver::project() {
     x.assign(static_cast<size_t>(ob.size()), 0.0);
   for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j)
     for (PetscInt i = ob.s[0]; i < ob.s[0] + ob.m[0]; ++i) {
-      if (solid(i, j)) continue;
-      const PetscInt c = grid_.local_index(i, j, 0);
+      const PetscInt c = grid_.local_index(i, j, 0), o = grid_.owned_index(i, j, 0);
+      if (solidv_[static_cast<size_t>(c)] > 0.5) continue;
       double div = 0.0;
       for (int d = 0; d < 2; ++d) {
         double gsum = 0.0;
@@ -164,16 +164,16 @@ void FluidSolver::project() {
         for (int s = -1; s <= 1; s += 2) {
           const PetscInt n =
               d == 0 ? grid_.local_index(i + s, j, 0) : grid_.local_index(i, j + s, 0);
-          const fluid::Face f = face(i, j, d, s);
-          const bool o = f.proj != fluid::ProjFace::Closed;
+          const fluid::Face& f = face_of(o, d, s);
+          const bool is_open = f.proj != fluid::ProjFace::Closed;
           const double pn = f.proj == fluid::ProjFace::Open ? p[n] : 0.0;
           const double gf = fluid::face_gradient(f, s, p[c], pn, h[d]);
           const double un = f.proj == fluid::ProjFace::Open ? u[d][n] : 0.0;
           div += s * (fluid::face_velocity(f, u[d][c], un) - gf) / h[d];
           gsum += gf;
-          open += o;
+          open += is_open;
         }
-        du[d][static_cast<size_t>(grid_.owned_index(i, j, 0))] = open ? gsum / open : 0.0;
+        du[d][static_cast<size_t>(o)] = open ? gsum / open : 0.0;
       }
       after += div * div;
     }

@@ -67,6 +67,7 @@ FluidSolver::FluidSolver(const Grid& grid, FluidSettings settings, const std::ve
   MG_PETSC(VecGetArray(solid_, &s));
   solidv_.assign(s, s + nl);
   MG_PETSC(VecRestoreArray(solid_, &s));
+  build_face_codes();
   p_local_ = grid.create_local();
   MG_PETSC(VecSet(p_local_, 0.0));
   p_ = grid.create_global();
@@ -159,6 +160,27 @@ fluid::Face FluidSolver::face(PetscInt i, PetscInt j, int d, int s) const {
   if (outside) return fluid::boundary_face(set_.kind, d, s, set_.lid, set_.inflow);
   if (solid(i, j) || (d == 0 ? solid(n, j) : solid(i, n))) return fluid::solid_face();
   return fluid::open_face();
+}
+
+void FluidSolver::build_face_codes() {
+  face_table_[0] = fluid::open_face();
+  face_table_[1] = fluid::solid_face();
+  for (int d = 0; d < 2; ++d)
+    for (int s = 0; s < 2; ++s)
+      face_table_[2 + 2 * d + s] =
+          fluid::boundary_face(set_.kind, d, 2 * s - 1, set_.lid, set_.inflow);
+  const Box& ob = grid_.owned();
+  face_code_.assign(static_cast<size_t>(4 * ob.size()), 0);
+  for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j)
+    for (PetscInt i = ob.s[0]; i < ob.s[0] + ob.m[0]; ++i)
+      for (int d = 0; d < 2; ++d)
+        for (int s = 0; s < 2; ++s) {
+          bool outside = false;
+          const PetscInt n = neighbour(d == 0 ? i : j, d, 2 * s - 1, outside);
+          const bool closed = !outside && (solid(i, j) || (d == 0 ? solid(n, j) : solid(i, n)));
+          face_code_[static_cast<size_t>(4 * grid_.owned_index(i, j, 0) + 2 * d + s)] =
+              static_cast<std::uint8_t>(outside ? 2 + 2 * d + s : (closed ? 1 : 0));
+        }
 }
 
 void FluidSolver::zero_solid(Vec local) const {

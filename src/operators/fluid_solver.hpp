@@ -24,6 +24,7 @@
 
 #include "operators/spectral_solver.hpp"
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -92,6 +93,12 @@ private:
   void assemble_poisson();
   void configure_ksp(KSP* ksp, const char* prefix, bool poisson);
   fluid::Face face(PetscInt i, PetscInt j, int d, int s) const;
+  // The faces of the owned cells, fixed for the run: face(i, j, d, s) of owned cell o is
+  // face_table_[face_code_[4 o + 2 d + (s > 0)]] (open, solid, or one of the 4 boundary faces).
+  void build_face_codes();
+  const fluid::Face& face_of(PetscInt o, int d, int s) const {
+    return face_table_[face_code_[static_cast<size_t>(4 * o + 2 * d + (s > 0 ? 1 : 0))]];
+  }
   PetscInt neighbour(PetscInt i, int d, int s, bool& outside) const;
   void refresh(Vec local) const;
   // Owned cells of a ghosted local array into a global Vec (to_local: the other way).
@@ -103,6 +110,8 @@ private:
   Halo halo_;
   VecH u_[2], solid_, p_, p_local_, rhs_, x_;
   std::vector<double> solidv_; // the ghosted solid mask (1: obstacle)
+  std::vector<std::uint8_t> face_code_;
+  fluid::Face face_table_[6];
   std::unique_ptr<WideHalo> wide_;
   advect::WideGeom geom_;
   std::vector<double> wu_[2];
