@@ -154,14 +154,12 @@ PetscInt FluidSolver::neighbour(PetscInt i, int d, int s, bool& outside) const {
   return n;
 }
 
-fluid::Face FluidSolver::face(PetscInt i, PetscInt j, int d, int s) const {
-  bool outside = false;
-  const PetscInt n = neighbour(d == 0 ? i : j, d, s, outside);
-  if (outside) return fluid::boundary_face(set_.kind, d, s, set_.lid, set_.inflow);
-  if (solid(i, j) || (d == 0 ? solid(n, j) : solid(i, n))) return fluid::solid_face();
-  return fluid::open_face();
+const fluid::Face& FluidSolver::face(PetscInt i, PetscInt j, int d, int s) const {
+  return face_of(grid_.owned_index(i, j, 0), d, s);
 }
 
+// Each owned cell's faces: a boundary face where the neighbour lies outside a non-periodic
+// grid, closed where the cell or its neighbour is solid, else open.
 void FluidSolver::build_face_codes() {
   face_table_[0] = fluid::open_face();
   face_table_[1] = fluid::solid_face();

@@ -92,7 +92,8 @@ private:
   void assemble_viscous(double h);
   void assemble_poisson();
   void configure_ksp(KSP* ksp, const char* prefix, bool poisson);
-  fluid::Face face(PetscInt i, PetscInt j, int d, int s) const;
+  // The face on side s (-1, +1) of axis d of owned cell (i, j).
+  const fluid::Face& face(PetscInt i, PetscInt j, int d, int s) const;
   // The faces of the owned cells, fixed for the run: face(i, j, d, s) of owned cell o is
   // face_table_[face_code_[4 o + 2 d + (s > 0)]] (open, solid, or one of the 4 boundary faces).
   void build_face_codes();
