@@ -26,6 +26,11 @@ another irregular list of values is drawn evenly spaced (categorical). Points no
 sweep.json (an unfinished sweep) are blank (light grey) cells; a point whose field file is
 missing shows its class only. A 1-axis sweep gives a strip, a 3-axis sweep one panel per
 value of the third axis (at most 16 panels). Non-finite values (blow-ups) are drawn black.
+
+A sweep over a list of points (`-sweep_points`, e.g. a screen's Turing-unstable sets) has no
+grid: <prefix>_classes.png is then a scatter plot of the points over the first two axes (one
+axis: over the point index), coloured by class, and <prefix>_mosaic.png the thumbnails in point
+order (at most 400, evenly chosen), each labelled with its axis values.
 Bad input: a one-line error on stderr and exit status 1.
 """
 import argparse
@@ -167,7 +172,7 @@ def load_sweep(directory):
             [float(x) for x in a["values"]]
         except (TypeError, ValueError):
             raise InputError(f"{path}: axis {a['option']}: non-numeric values")
-    if len(sweep["axes"]) > 3:
+    if len(sweep["axes"]) > 3 and "points_file" not in sweep:
         raise InputError(f"{path}: {len(sweep['axes'])} axes; only 1-, 2- and 3-axis sweeps can be drawn")
     recs = sweep.get("records", [])
     if not isinstance(recs, list):
@@ -600,6 +605,56 @@ def summary_line(sweep, mosaic, classes, nthumbs, unreadable, drawn):
             f"classes: {cls}; {bound}; {nthumbs} thumbnails{extra}; wrote {mosaic}, {classes}")
 
 
+MAX_LISTED_THUMBS = 400
+
+
+def write_listed(directory, raw, prefix, species, thumb_px):
+    """The figures of a listed sweep (see the module text); returns the summary line."""
+    recs = sorted((r for r in raw["records"] if isinstance(r.get("index"), int)),
+                  key=lambda r: r["index"])
+    opts = [a["option"] for a in raw["axes"]]
+    labels = [strip_prefix(o) for o in opts]
+    fig, ax = plt.subplots(figsize=(7, 5.5))
+    counts = {}
+    for r in recs:
+        counts[r.get("class", "?")] = counts.get(r.get("class", "?"), 0) + 1
+    for c in sorted(counts, key=lambda c: (-counts[c], c)):
+        sel = [r for r in recs if r.get("class", "?") == c]
+        xs = [r["params"].get(opts[0]) if len(opts) > 1 else r["index"] for r in sel]
+        ys = [r["params"].get(opts[1 if len(opts) > 1 else 0]) for r in sel]
+        ax.scatter(xs, ys, s=18, color=CLASS_COLOURS.get(c, OTHER_COLOUR), label=f"{c} ({counts[c]})",
+                   edgecolors="none")
+    ax.set_xlabel(labels[0] if len(opts) > 1 else "point")
+    ax.set_ylabel(labels[1] if len(opts) > 1 else labels[0])
+    ax.legend(fontsize=8, loc="best")
+    ax.set_title(f"{len(recs)}/{raw.get('points', len(recs))} points of {raw.get('points_file', '')}")
+    fig.savefig(prefix + "_classes.png", dpi=DPI)
+    plt.close(fig)
+    step = max(1, math.ceil(len(recs) / MAX_LISTED_THUMBS))
+    shown = recs[::step]
+    cols = max(1, min(10, len(shown)))
+    rows = max(1, math.ceil(len(shown) / cols))
+    size = max(thumb_px, 48) / DPI
+    fig, axes = plt.subplots(rows, cols, figsize=(cols * size * 1.6, rows * size * 1.9), squeeze=False)
+    for a in axes.flat:
+        a.axis("off")
+    for a, r in zip(axes.flat, shown):
+        f = r.get("file")
+        if isinstance(f, str) and os.path.isfile(os.path.join(directory, f)):
+            arr, _ = read_field(os.path.join(directory, f), species or r.get("species"))
+            a.imshow(arr, origin="lower", cmap="viridis", interpolation="nearest")
+        a.set_title(f"{r['index']}: " + ", ".join(f"{fmt_value(r['params'].get(o, float('nan')))}"
+                                                  for o in opts) + f"\n{r.get('class', '?')}",
+                    fontsize=6)
+    fig.tight_layout()
+    fig.savefig(prefix + "_mosaic.png", dpi=DPI)
+    plt.close(fig)
+    cls = ", ".join(f"{c} {counts[c]}" for c in sorted(counts, key=lambda c: (-counts[c], c))) or "none"
+    return (f"{PROG}: {directory}: {len(recs)}/{raw.get('points', len(recs))} listed points "
+            f"({', '.join(labels)}); classes: {cls}; {len(shown)} thumbnails; wrote "
+            f"{prefix}_mosaic.png, {prefix}_classes.png")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("sweep_dir")
@@ -612,6 +667,10 @@ def main(argv=None):
         if args.thumb_px < 4:
             raise InputError(f"--thumb-px {args.thumb_px}: must be at least 4")
         raw = load_sweep(args.sweep_dir)
+        if "points_file" in raw:
+            prefix = args.out_prefix or os.path.join(args.sweep_dir, "phase")
+            print(write_listed(args.sweep_dir, raw, prefix, args.species, args.thumb_px))
+            return 0
         sweep = Sweep(args.sweep_dir, raw, args.species, args.swap_axes)
         prefix = args.out_prefix or os.path.join(args.sweep_dir, "phase")
         outdir = os.path.dirname(prefix)

@@ -33,7 +33,8 @@ size_t find_plus_minus(const std::string& s) {
   return std::string::npos;
 }
 
-// A file named in a value: relative to the deck's directory when it exists there.
+} // namespace
+
 std::string resolve_path(const std::string& base_dir, const std::string& file) {
   if (base_dir.empty() || file.empty() || file[0] == '/') return file;
   const std::string alt = base_dir + "/" + file;
@@ -43,6 +44,8 @@ std::string resolve_path(const std::string& base_dir, const std::string& file) {
   }
   return file;
 }
+
+namespace {
 
 // Cell index of coordinate x along axis d: wrapped (periodic) or clamped to the grid.
 int cell_of(double x, const GridSpec& g, int d) {

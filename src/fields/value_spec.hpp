@@ -56,6 +56,10 @@ inline constexpr long kMaxSpots = 100000;
 // wrong and what is allowed (for the one-line error).
 std::string top_level_problem(const std::string& expr);
 
+// A file named in a value or option: base_dir/file when that exists (a deck's relative names),
+// else file as given (relative to the working directory).
+std::string resolve_path(const std::string& base_dir, const std::string& file);
+
 class ValueSpec {
 public:
   // key: the option name (used in error messages and as the random stream name).

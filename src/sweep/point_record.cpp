@@ -28,8 +28,8 @@ const nlohmann::json& at(const nlohmann::json& j, const char* a, const char* b =
 
 } // namespace
 
-std::string csv_header(const std::vector<std::string>& axes) {
-  std::string h = "index";
+std::string csv_header(const std::vector<std::string>& axes, bool listed) {
+  std::string h = listed ? "index,source_index" : "index";
   for (const auto& a : axes)
     h += "," + a;
   return h + ",class,wavelength,wavelength_cells,contrast,spots,holes,spot_area,euler,"
@@ -37,8 +37,9 @@ std::string csv_header(const std::vector<std::string>& axes) {
              "runtime_s,file\n";
 }
 
-std::string csv_row(const nlohmann::json& r, const std::vector<std::string>& axes) {
+std::string csv_row(const nlohmann::json& r, const std::vector<std::string>& axes, bool listed) {
   std::string row = cell(r["index"]);
+  if (listed) row += "," + cell(at(r, "source_index"));
   for (const auto& a : axes)
     row += "," + cell(at(r, "params").contains(a) ? r["params"][a] : nlohmann::json());
   const auto& m = at(r, "metrics");

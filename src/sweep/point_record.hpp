@@ -9,9 +9,11 @@
 
 namespace morphogen::sweep {
 
-// The CSV header and row of a record (columns: index, the axis options, class, the main
-// metrics, stability, run time, file).
-std::string csv_header(const std::vector<std::string>& axes);
-std::string csv_row(const nlohmann::json& record, const std::vector<std::string>& axes);
+// The CSV header and row of a record (columns: index, for a listed sweep source_index (the
+// point's index in the points file), the axis options, class, the main metrics, stability, run
+// time, file).
+std::string csv_header(const std::vector<std::string>& axes, bool listed);
+std::string csv_row(const nlohmann::json& record, const std::vector<std::string>& axes,
+                    bool listed);
 
 } // namespace morphogen::sweep

@@ -21,6 +21,20 @@ std::string point_file(long long p, const char* ext) {
 
 namespace {
 
+// The start of point p's record: its index (and, listed, its index in the points file) and the
+// axis values.
+nlohmann::json record_head(const SweepSpec& spec, long long p) {
+  nlohmann::json r;
+  r["index"] = p;
+  if (spec.listed) r["source_index"] = spec.source[static_cast<size_t>(p)];
+  nlohmann::json params = nlohmann::json::object();
+  const std::vector<double> values = spec.numbers(p);
+  for (size_t ax = 0; ax < spec.axes.size(); ++ax)
+    params[spec.axes[ax].option] = values[ax];
+  r["params"] = params;
+  return r;
+}
+
 nlohmann::json run_point_impl(const SweepSpec& spec, long long p, const SweepSettings& set,
                               WorkQueue& q, bool& interrupted) {
   MPI_Comm comm = q.group();
@@ -72,9 +86,9 @@ nlohmann::json run_point_impl(const SweepSpec& spec, long long p, const SweepSet
   attrs.reals = {{"time", sim.time()}};
   attrs.ints = {{"step", static_cast<long long>(sim.step_index())}, {"point", p}};
   attrs.strings = {{"model", sim.model().name}};
+  const std::vector<double> values = spec.numbers(p);
   for (size_t ax = 0; ax < assignment.size(); ++ax)
-    attrs.reals.emplace_back(assignment[ax].first,
-                             spec.axes[ax].numbers[static_cast<size_t>(spec.indices(p)[ax])]);
+    attrs.reals.emplace_back(assignment[ax].first, values[ax]);
   std::vector<Vec> vecs;
   for (auto& v : sim.state())
     vecs.push_back(v);
@@ -94,12 +108,7 @@ nlohmann::json run_point_impl(const SweepSpec& spec, long long p, const SweepSet
     MPI_Abort(MPI_COMM_WORLD, 4);
   }
 
-  nlohmann::json r;
-  r["index"] = p;
-  nlohmann::json params = nlohmann::json::object();
-  for (size_t ax = 0; ax < assignment.size(); ++ax)
-    params[assignment[ax].first] = spec.axes[ax].numbers[static_cast<size_t>(spec.indices(p)[ax])];
-  r["params"] = params;
+  nlohmann::json r = record_head(spec, p);
   r["species"] = names[static_cast<size_t>(sm)];
   r["model"] = sim.model().name;
   r["steps"] = static_cast<long long>(sim.step_index());
@@ -134,16 +143,12 @@ nlohmann::json run_point(const SweepSpec& spec, long long p, const SweepSettings
     int rank = 0;
     MPI_Comm_rank(q.group(), &rank);
     if (rank != 0) return {};
-    nlohmann::json params = nlohmann::json::object();
-    const auto idx = spec.indices(p);
-    for (size_t ax = 0; ax < spec.axes.size(); ++ax)
-      params[spec.axes[ax].option] = spec.axes[ax].numbers[static_cast<size_t>(idx[ax])];
     std::fprintf(stderr, "morphogen: warning: sweep point %lld: %s\n", p, e.what());
-    return {{"index", p},
-            {"params", params},
-            {"class", "error"},
-            {"reason", e.what()},
-            {"runtime_s", MPI_Wtime() - t0}};
+    nlohmann::json r = record_head(spec, p);
+    r["class"] = "error";
+    r["reason"] = e.what();
+    r["runtime_s"] = MPI_Wtime() - t0;
+    return r;
   }
 }
 

@@ -6,7 +6,9 @@
 #include "app/simulation.hpp"
 #include "core/collective_error.hpp"
 #include "core/user_error.hpp"
+#include "fields/value_spec.hpp"
 #include "io/series_index.hpp"
+#include "sweep/point_list.hpp"
 #include "sweep/point_record.hpp"
 #include "sweep/point_runner.hpp"
 #include "sweep/sweep_table.hpp"
@@ -53,11 +55,14 @@ struct Setup {
   double max_walltime = 0; // minutes
 };
 
-Setup read_setup(Options& opt, const std::string& base_dir) {
-  Setup s;
-  const auto axes = opt.list("sweep_axes", {}, 1, 3,
-                             "options swept (1 to 3), e.g. params_F,params_k; each needs "
-                             "-sweep_<option> with its values");
+constexpr const char* kAxesHelp =
+    "options swept (1 to 3), e.g. params_F,params_k; each needs -sweep_<option> with its values "
+    "(with -sweep_points: 1 to 16 columns of the file; default: a screen file's varied ones)";
+
+// The axes of a product sweep: -sweep_axes and each axis's -sweep_<option> values.
+SweepSpec read_product_axes(Options& opt, std::vector<std::string>& known) {
+  SweepSpec spec;
+  const auto axes = opt.list("sweep_axes", {}, 1, 3, kAxesHelp);
   for (const auto& a : axes) {
     if (std::count(axes.begin(), axes.end(), a) > 1)
       throw UserError("-sweep_axes: " + a + " is given twice");
@@ -71,10 +76,45 @@ Setup read_setup(Options& opt, const std::string& base_dir) {
     ax.values = parse_axis_values(key, *text);
     for (const auto& v : ax.values)
       ax.numbers.push_back(Options::parse_real(key, v));
-    s.spec.axes.push_back(std::move(ax));
-    s.set.known.push_back(key);
+    spec.axes.push_back(std::move(ax));
+    known.push_back(key);
   }
-  if (s.spec.points() > 10000000) throw UserError("-sweep_axes: more than 10^7 points");
+  return spec;
+}
+
+// The axes of a listed sweep: the rows of -sweep_points (point_list.hpp).
+SweepSpec read_listed_axes(Options& opt, const std::string& file, const std::string& base_dir,
+                           long long max_points) {
+  const auto axes = opt.is_set("sweep_axes") ? opt.list("sweep_axes", {}, 1, 16, kAxesHelp)
+                                             : std::vector<std::string>();
+  for (const auto& a : axes) {
+    if (std::count(axes.begin(), axes.end(), a) > 1)
+      throw UserError("-sweep_axes: " + a + " is given twice");
+    if (opt.is_set("sweep_" + a))
+      throw UserError("-sweep_" + a + ": not used with -sweep_points " + file + " (the values of " +
+                      a + " come from the file)");
+  }
+  return read_point_list("sweep_points", resolve_path(base_dir, file), axes, max_points);
+}
+
+Setup read_setup(Options& opt, const std::string& base_dir) {
+  Setup s;
+  const std::string points =
+      opt.string("sweep_points", "",
+                 "CSV file of points, one per row (a header names the columns; e.g. a screen's "
+                 "turing_sets.csv): sweep these instead of the product of the axes' values");
+  const long long max_points = opt.integer(
+      "sweep_points_max", 0, 0, 10000000,
+      "with -sweep_points: at most N points, evenly spaced rows of the file (0: every row)");
+  if (points.empty() && opt.is_set("sweep_points_max"))
+    throw UserError("-sweep_points_max " + std::to_string(max_points) +
+                    ": needs -sweep_points (a file of points)");
+  s.spec = points.empty() ? read_product_axes(opt, s.set.known)
+                          : read_listed_axes(opt, points, base_dir, max_points);
+  if (s.spec.points() > 10000000)
+    throw UserError(points.empty() ? "-sweep_axes: more than 10^7 points"
+                                   : "-sweep_points " + points +
+                                         ": more than 10^7 rows (use -sweep_points_max)");
   s.group_size = static_cast<int>(
       opt.integer("sweep_group_size", 1, 1, 1 << 20, "ranks per sweep point (divides the ranks)"));
   int world_size = 1;
@@ -104,48 +144,73 @@ Setup read_setup(Options& opt, const std::string& base_dir) {
     throw UserError("-restart " + restart +
                     ": a sweep always resumes from its finished points; allowed: latest");
   s.set.base_dir = base_dir;
-  for (const char* k : {"sweep_axes", "sweep_group_size", "sweep_chunks", "sweep_chunk",
-                        "sweep_species", "sweep_samples", "max_walltime", "restart"})
+  for (const char* k :
+       {"sweep_axes", "sweep_points", "sweep_points_max", "sweep_group_size", "sweep_chunks",
+        "sweep_chunk", "sweep_species", "sweep_samples", "max_walltime", "restart"})
     s.set.known.emplace_back(k);
   return s;
 }
 
-// Every rank, on PETSC_COMM_SELF: build the simulation of every axis value (others at their
-// first value) so a bad value fails before anything runs. Returns the first point's options.
+// The points whose simulations are built before the sweep runs: point 0, then for a product
+// every value of each axis (the others at their first value), for a list the rows holding each
+// axis's smallest and largest value.
+std::vector<long long> points_to_validate(const SweepSpec& spec) {
+  std::vector<long long> out{0};
+  for (size_t a = 0; a < spec.axes.size(); ++a) {
+    const auto& v = spec.axes[a].numbers;
+    if (spec.listed) {
+      out.push_back(std::min_element(v.begin(), v.end()) - v.begin());
+      out.push_back(std::max_element(v.begin(), v.end()) - v.begin());
+      continue;
+    }
+    long long stride = 1;
+    for (size_t b = 0; b < a; ++b)
+      stride *= static_cast<long long>(spec.axes[b].values.size());
+    for (size_t i = 1; i < v.size(); ++i)
+      out.push_back(static_cast<long long>(i) * stride);
+  }
+  std::sort(out.begin() + 1, out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+// Every rank, on PETSC_COMM_SELF: build the simulation of each point of points_to_validate so a
+// bad value fails before anything runs. Returns the first point's options.
 std::string validate(const Setup& s, const Options& sopt, std::string& dir) {
   std::string yaml;
-  const size_t na = s.spec.axes.size();
-  for (size_t a = 0; a < na; ++a)
-    for (size_t v = 0; v < s.spec.axes[a].values.size(); ++v) {
-      if (a > 0 && v == 0) continue;
-      for (size_t b = 0; b < na; ++b)
-        MG_PETSC(PetscOptionsSetValue(
-            nullptr, ("-" + s.spec.axes[b].option).c_str(),
-            (b == a ? s.spec.axes[b].values[v] : s.spec.axes[b].values[0]).c_str()));
-      Options opt(PETSC_COMM_SELF);
-      for (const auto& k : s.set.known)
-        opt.known(k);
-      Simulation sim(PETSC_COMM_SELF, opt, s.set.base_dir);
-      if (!s.set.species.empty()) {
-        const auto& n = sim.species();
-        if (std::find(n.begin(), n.end(), s.set.species) == n.end())
-          throw UserError("-sweep_species " + s.set.species + ": no such species in model " +
-                          sim.model().name);
-      }
-      if (a == 0 && v == 0) {
-        const std::string model = sim.model().name;
-        opt.set_unknown_hint(
-            [model](const std::string& name) { return other_model_hint(name, model); });
-        opt.check_unused();
-        dir = sim.output().dir;
-        yaml = opt.to_yaml("");
-        if (opt.help_requested()) { // the options are listed once
-          print_options_help(PETSC_COMM_WORLD, {&sopt, &opt});
-          print_models_help(PETSC_COMM_WORLD);
-          return yaml;
-        }
+  for (const long long p : points_to_validate(s.spec)) {
+    for (const auto& [option, value] : s.spec.assignment(p))
+      MG_PETSC(PetscOptionsSetValue(nullptr, ("-" + option).c_str(), value.c_str()));
+    Options opt(PETSC_COMM_SELF);
+    for (const auto& k : s.set.known)
+      opt.known(k);
+    Simulation sim(PETSC_COMM_SELF, opt, s.set.base_dir);
+    if (!s.set.species.empty()) {
+      const auto& n = sim.species();
+      if (std::find(n.begin(), n.end(), s.set.species) == n.end())
+        throw UserError("-sweep_species " + s.set.species + ": no such species in model " +
+                        sim.model().name);
+    }
+    if (p == 0) {
+      const std::string model = sim.model().name;
+      opt.set_unknown_hint(
+          [model](const std::string& name) { return other_model_hint(name, model); });
+      opt.check_unused();
+      dir = sim.output().dir;
+      yaml = opt.to_yaml("");
+      int rank = 0;
+      MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+      if (s.spec.listed && rank == 0)
+        for (const auto& w : screen_mismatches(s.spec, sim))
+          std::fprintf(stderr, "morphogen: warning: -sweep_points %s: %s\n",
+                       s.spec.points_file.c_str(), w.c_str());
+      if (opt.help_requested()) { // the options are listed once
+        print_options_help(PETSC_COMM_WORLD, {&sopt, &opt});
+        print_models_help(PETSC_COMM_WORLD);
+        return yaml;
       }
     }
+  }
   return yaml;
 }
 
@@ -202,10 +267,11 @@ int run_sweep(int* argc, char*** argv, const std::vector<OptionsFileArg>& option
   const std::string deck_dir = load_deck(argc, argv, options_files);
   Options sopt(world);
   const std::string base_dir = read_deck_dir(sopt, deck_dir);
-  if (!sopt.is_set("sweep_axes"))
+  if (!sopt.is_set("sweep_axes") && !sopt.is_set("sweep_points"))
     throw UserError("deck " + deck +
                     ": no sweep: section (sweep: {axes: [params_F, ...], params_F: "
-                    "linspace(a, b, n), ...}); to run it once: morphogen " +
+                    "linspace(a, b, n), ...} or sweep: {points: FILE.csv}); to run it once: "
+                    "morphogen " +
                     deck);
   Setup s = read_setup(sopt, base_dir);
   std::string dir;
@@ -233,10 +299,11 @@ int run_sweep(int* argc, char*** argv, const std::vector<OptionsFileArg>& option
     for (long long p = s.chunk; p < npoints; p += s.chunks)
       if (std::find(done.begin(), done.end(), p) == done.end()) todo.push_back(p);
     if (err.empty()) {
-      std::string axes;
+      std::string axes = s.spec.listed ? "rows of " + s.spec.points_file + ": " : "";
       for (const auto& ax : s.spec.axes)
-        axes +=
-            (axes.empty() ? "" : " x ") + ax.option + "[" + std::to_string(ax.values.size()) + "]";
+        axes += s.spec.listed ? (ax.option == s.spec.axes[0].option ? "" : ", ") + ax.option
+                              : (ax.option == s.spec.axes[0].option ? "" : " x ") + ax.option +
+                                    "[" + std::to_string(ax.values.size()) + "]";
       std::printf("sweep: %lld points (%s), chunk %lld/%lld: %zu to run, %zu already done -> %s/\n",
                   npoints, axes.c_str(), s.chunk, s.chunks, todo.size(), done.size(), dir.c_str());
       std::fflush(stdout);

@@ -27,6 +27,7 @@ std::string trim(const std::string& s) {
 } // namespace
 
 long long SweepSpec::points() const {
+  if (listed) return axes.empty() ? 0 : static_cast<long long>(axes[0].values.size());
   long long n = 1;
   for (const auto& a : axes)
     n *= static_cast<long long>(a.values.size());
@@ -34,6 +35,7 @@ long long SweepSpec::points() const {
 }
 
 std::vector<long long> SweepSpec::indices(long long p) const {
+  if (listed) return std::vector<long long>(axes.size(), p);
   std::vector<long long> idx;
   for (const auto& a : axes) {
     const long long n = static_cast<long long>(a.values.size());
@@ -48,6 +50,14 @@ std::vector<std::pair<std::string, std::string>> SweepSpec::assignment(long long
   const auto idx = indices(p);
   for (size_t a = 0; a < axes.size(); ++a)
     out.emplace_back(axes[a].option, axes[a].values[static_cast<size_t>(idx[a])]);
+  return out;
+}
+
+std::vector<double> SweepSpec::numbers(long long p) const {
+  std::vector<double> out;
+  const auto idx = indices(p);
+  for (size_t a = 0; a < axes.size(); ++a)
+    out.push_back(axes[a].numbers[static_cast<size_t>(idx[a])]);
   return out;
 }
 

@@ -8,6 +8,8 @@
 //
 // Points are the Cartesian product, numbered with the first axis fastest:
 //   p = i0 + n0 (i1 + n1 i2).
+// A listed sweep (-sweep_points, point_list.hpp) instead takes point p from row p of a file:
+// value p of every axis.
 // A sweep may be split into chunks (job arrays): chunk c of C holds the points p with
 // p mod C == c, so every chunk gets a similar mix of cheap and expensive points.
 #pragma once
@@ -26,11 +28,16 @@ struct Axis {
 
 struct SweepSpec {
   std::vector<Axis> axes;
+  bool listed = false;           // point p = value p of every axis
+  std::string points_file;       // listed: the file read
+  std::vector<long long> source; // listed: each point's index in that file
   long long points() const;
   // Axis indices of point p.
   std::vector<long long> indices(long long p) const;
   // (option, value) pairs of point p.
   std::vector<std::pair<std::string, std::string>> assignment(long long p) const;
+  // The axis values of point p as numbers.
+  std::vector<double> numbers(long long p) const;
 };
 
 // Parses "linspace(a, b, n)", "logspace(a, b, n)" (10^a .. 10^b), "range(a, b, step)" (b

@@ -48,9 +48,10 @@ bool past_hopf(const analysis::StabilityResult& st) {
   return tr > st.tol && det > 0;
 }
 
-// Linear stability over a refined grid of the axes (empty when an axis is not a model
-// parameter or diffusion coefficient, or a parameter varies in space).
+// Linear stability over a refined grid of the axes (empty for a listed sweep, when an axis is
+// not a model parameter or diffusion coefficient, or when a parameter varies in space).
 nlohmann::json stability_map(const SweepSpec& spec, const std::string& base_dir) {
+  if (spec.listed) return {};
   // The base configuration: the options database holds the deck plus the last point's values.
   Options opt(PETSC_COMM_SELF);
   for (const auto& a : spec.axes)
@@ -139,7 +140,7 @@ std::string write_sweep_table(const std::string& dir, const SweepSpec& spec,
     names.push_back(a.option);
     axes.push_back({{"option", a.option}, {"values", a.numbers}});
   }
-  std::string csv = csv_header(names);
+  std::string csv = csv_header(names, spec.listed);
   nlohmann::json records = nlohmann::json::array();
   std::map<std::string, int> classes;
   for (long long p = 0; p < spec.points(); ++p) {
@@ -148,7 +149,7 @@ std::string write_sweep_table(const std::string& dir, const SweepSpec& spec,
     nlohmann::json r = nlohmann::json::parse(f, nullptr, false);
     if (r.is_discarded() || !r.contains("class")) continue;
     r.erase("series");
-    csv += csv_row(r, names);
+    csv += csv_row(r, names, spec.listed);
     ++classes[r["class"].get<std::string>()];
     records.push_back(std::move(r));
   }
@@ -156,6 +157,7 @@ std::string write_sweep_table(const std::string& dir, const SweepSpec& spec,
       {"axes", axes},       {"points", spec.points()},      {"finished", records.size()},
       {"classes", classes}, {"base_options", base_options}, {"records", records}};
   j["stability_map"] = std::move(map);
+  if (spec.listed) j["points_file"] = spec.points_file;
   std::string err = io::write_file_atomically(dir + "/sweep.csv", csv);
   if (err.empty())
     err = io::write_file_atomically(

@@ -3,7 +3,6 @@ small grid) finishes and writes a table of every point with a class; a sweep sto
 (SIGUSR1: exit 3; or killed outright) resumes without redoing finished points; chunks for job
 arrays cover the sweep exactly once; results do not depend on the rank-group layout; bad sweep
 input is refused with one line."""
-import json
 import os
 import signal
 import subprocess
@@ -13,22 +12,14 @@ import time
 import pytest
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "app"))
+sys.path.insert(0, os.path.dirname(__file__))
+from sweep_helpers import ok, table  # noqa: E402
 from conftest import EXE, MPIEXEC, SOURCE, run  # noqa: E402
 
 DECK = os.path.join(SOURCE, "input", "gray_scott_sweep.yaml")
 SMALL = ["-grid_n", "32,32", "-grid_L", "0.3125", "-steps", "2000"]
 CLASSES = {"uniform", "spots", "holes", "stripes", "labyrinth", "mixed", "oscillating",
            "chaotic", "blowup"}
-
-
-def ok(r):
-    assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
-    return r
-
-
-def table(d):
-    with open(os.path.join(d, "sweep.json")) as f:
-        return json.load(f)
 
 
 def test_gray_scott_16x16_sweep_on_2_ranks(tmp_path):
