@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "app"))
-from conftest import run  # noqa: E402
+from conftest import SOURCE, run  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(__file__))
 from deck_runs import deck_runner, summary  # noqa: E402
@@ -44,6 +44,8 @@ EXPECTED = {
     "witkin_kass_maze": {"m2": "labyrinth"},   # WK Fig. 3-3b: two-direction D-A maze
     "witkin_kass_twisty_maze": {"p3": "labyrinth", "m3": "labyrinth"},  # WK Fig. 3-2c: five-direction D-A
     "witkin_kass_sand": {"p1": "stripes", "m1": "stripes"},  # WK Fig. 3-3a: ripples along y
+    "witkin_kass_space_giraffe": {"cp": "holes"},  # WK Fig. 3-4a: giraffe, k falling early
+    "witkin_kass_stucco": {"cp": "labyrinth"},  # WK Fig. 3-4c: grainy labyrinth, k = e^(t/4)
     "witkin_kass_radial": {"p1": "mixed", "p2": "mixed"},  # WK Fig. 3-3d: spokes and rings woven
     "witkin_kass_double_spiral": {"p1": "mixed", "p2": "mixed"},  # WK Fig. 3-2a: two spirals woven
     "witkin_kass_zebra_haunch": {"p1": "labyrinth", "m1": "labyrinth"},  # WK Fig. 3-3c: curved stripes
@@ -91,6 +93,26 @@ def test_wk_giraffe_cells_are_coarser_than_reptile_scales(deck_run):
         assert m["low"]["spots"] >= least and m["low"]["spot_area_fraction"] >= 0.8, (deck, m["low"])
         cells[deck] = m["low"]["spot_area_cells"]
     assert cells["witkin_kass_giraffe"] >= 2.5 * cells["witkin_kass_reptile"], cells
+
+
+
+def test_wk_space_giraffe_and_stucco_differ_from_constant_k(deck_run, tmp_path):
+    """Varying k over time (WK section 6.1): the space giraffe (the giraffe deck with k falling
+    to e^-10 by t = 10) ends still, with round dark patches in a bright network that covers over
+    half the area where the giraffe's covers under 0.45; the stucco (k = e^(t/4) from noise)
+    breaks into at least 3 times as many bright pieces as the same deck with k = 1."""
+    g = summary(deck_run("witkin_kass_giraffe"))["species"]["cp"]
+    sg = summary(deck_run("witkin_kass_space_giraffe"))["species"]["cp"]
+    assert g["metrics"]["high"]["area_fraction"] < 0.45, g["metrics"]["high"]
+    assert sg["metrics"]["high"]["area_fraction"] > 0.5, sg["metrics"]["high"]
+    assert sg["metrics"]["high"]["networks"] == 1 and sg["metrics"]["low"]["spots"] >= 10
+    assert sg["dynamics"]["behaviour"] == "stationary", sg["dynamics"]
+    st = summary(deck_run("witkin_kass_stucco"))["species"]["cp"]["metrics"]
+    r = run([os.path.join(SOURCE, "input", "witkin_kass_stucco.yaml"), "-params_k", "1",
+             "-output_dir", "k1", "-png_every", "0"], tmp_path, 2, timeout=300)
+    assert r.returncode == 0, r.stderr[-1500:]
+    k1 = summary(tmp_path / "k1")["species"]["cp"]["metrics"]
+    assert st["high"]["components"] >= 3 * k1["high"]["components"], (st["high"], k1["high"])
 
 # Witkin-Kass buttons on orientation maps and the mazes: the local stripe direction of the final
 # checkpoint (tests/analysis/wk_orientation.py) against the deck's own -tensor_*_theta map.
