@@ -1,5 +1,7 @@
 #include "io/h5_arrays.hpp"
 
+#include "io/h5_handle.hpp"
+
 #include <hdf5.h>
 
 #include <cstdio>
@@ -8,31 +10,6 @@
 namespace morphogen::io {
 
 namespace {
-
-// HDF5 handle closed on scope exit.
-struct H5Handle {
-  hid_t id;
-  herr_t (*close)(hid_t);
-  H5Handle(hid_t i, herr_t (*c)(hid_t)) : id(i), close(c) {}
-  H5Handle(const H5Handle&) = delete;
-  H5Handle& operator=(const H5Handle&) = delete;
-  ~H5Handle() {
-    if (id >= 0) close(id);
-  }
-  bool ok() const { return id >= 0; }
-  operator hid_t() const { return id; }
-};
-
-// Silences HDF5's error-stack printing for the scope (our messages say what went wrong).
-struct H5Silent {
-  H5E_auto2_t func = nullptr;
-  void* data = nullptr;
-  H5Silent() {
-    H5Eget_auto2(H5E_DEFAULT, &func, &data);
-    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  }
-  ~H5Silent() { H5Eset_auto2(H5E_DEFAULT, func, data); }
-};
 
 // True when every link along the absolute path exists and the last is a dataset.
 bool is_dataset(hid_t file, const std::string& p) {

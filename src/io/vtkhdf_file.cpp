@@ -1,5 +1,7 @@
 #include "io/vtkhdf_file.hpp"
 
+#include "io/h5_handle.hpp"
+
 #include <hdf5.h>
 #include <nlohmann/json.hpp>
 #include <petscdmda.h>
@@ -38,16 +40,7 @@ struct H5Id {
   operator hid_t() const { return id; }
 };
 
-// Silences HDF5's automatic error-stack printing for the scope (errors are reported by us).
-struct H5Quiet {
-  H5E_auto2_t func = nullptr;
-  void* data = nullptr;
-  H5Quiet() {
-    H5Eget_auto2(H5E_DEFAULT, &func, &data);
-    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  }
-  ~H5Quiet() { H5Eset_auto2(H5E_DEFAULT, func, data); }
-};
+using H5Quiet = H5Silent;
 
 PetscErrorCode write_array_attr(hid_t obj, const char* name, hid_t mem_type, hid_t file_type,
                                 hsize_t n, const void* data) {

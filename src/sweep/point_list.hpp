@@ -1,6 +1,7 @@
 // A sweep over a list of points (-sweep_points FILE) instead of the product of the axes' values:
-// one point per data row of a CSV file whose first line names the columns, e.g. the
-// Turing-unstable sets a screen wrote (turing_sets.csv), so a sweep simulates only those.
+// one point per data row of a CSV file whose first line names the columns, or of an HDF5 table
+// (io/h5_table.hpp), e.g. the Turing-unstable sets a screen wrote (turing_sets.csv or .h5), so
+// a sweep simulates only those.
 //
 // Columns: an axis (an option, e.g. params_alpha or D_b) takes the column of its own name or,
 // for params_<p>, the column <p>. Without -sweep_axes the file must be a screen's

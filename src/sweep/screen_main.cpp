@@ -119,7 +119,8 @@ nlohmann::json summary_json(const ScreenSpec& s, const Counts& c, int ranks, dou
   j["compute_s"] = compute_s;
   j["wall_s"] = wall_s;
   j["sets_per_s"] = wall_s > 0 ? static_cast<double>(s.sampler.total()) / wall_s : 0.0;
-  j["table"] = "turing_sets.csv";
+  if (s.csv) j["table"] = "turing_sets.csv";
+  if (s.hdf5) j["table_h5"] = "turing_sets.h5";
   return j;
 }
 
@@ -160,6 +161,8 @@ int run_screen(int* argc, char*** argv, const std::vector<OptionsFileArg>& optio
   MPI_Barrier(world);
   const double t0 = MPI_Wtime();
   ScreenRows rows;
+  rows.csv = s.csv;
+  rows.numbers = s.hdf5;
   Counts counts;
   throw_if_any(world, screen_chunks(s, world, chunk, rows, counts));
   MPI_Allreduce(MPI_IN_PLACE, counts.v, 4, MPI_LONG_LONG, MPI_SUM, world);
@@ -167,9 +170,18 @@ int run_screen(int* argc, char*** argv, const std::vector<OptionsFileArg>& optio
   std::vector<std::string> species;
   for (int sp = 0; sp < s.model->nspecies; ++sp)
     species.emplace_back(s.model->species[sp].name);
-  err = write_screen_csv(world, s.output + "/turing_sets.csv",
-                         screen_csv_header(s.sampler.names, species), rows,
-                         (total + chunk - 1) / chunk);
+  const long long nchunks = (total + chunk - 1) / chunk;
+  if (s.csv)
+    err = write_screen_csv(world, s.output + "/turing_sets.csv",
+                           screen_csv_header(s.sampler.names, species), rows, nchunks);
+  if (s.hdf5 && err.empty()) {
+    std::vector<std::string> columns = s.sampler.names;
+    columns.insert(columns.end(), {"wavelength", "k", "growth"});
+    for (const auto& sp : species)
+      columns.push_back("u_" + sp);
+    err =
+        write_screen_h5(world, s.output + "/turing_sets.h5", columns, rows, nchunks, s.model->name);
+  }
   const double wall_s = MPI_Wtime() - t0;
   if (rank == 0 && err.empty())
     err = io::write_file_atomically(
@@ -183,9 +195,10 @@ int run_screen(int* argc, char*** argv, const std::vector<OptionsFileArg>& optio
   if (rank == 0) {
     std::printf("screen: %lld sets in %.2f s (%.3g sets/s on %d rank%s): %lld Turing-unstable, "
                 "%lld stable, %lld unstable at k = 0, %lld without a steady state; table "
-                "%s/turing_sets.csv\n",
+                "%s/turing_sets.%s\n",
                 total, wall_s, wall_s > 0 ? total / wall_s : 0.0, size, size == 1 ? "" : "s",
-                counts.v[3], counts.v[2], counts.v[1], counts.v[0], s.output.c_str());
+                counts.v[3], counts.v[2], counts.v[1], counts.v[0], s.output.c_str(),
+                s.csv ? (s.hdf5 ? "csv, .h5" : "csv") : "h5");
     std::fflush(stdout);
   }
   return 0;

@@ -1,6 +1,8 @@
 // Output of a Turing screen: see screen_output.hpp.
 #include "sweep/screen_output.hpp"
 
+#include "io/h5_table.hpp"
+
 #include <algorithm>
 #include <charconv>
 #include <cstdio>
@@ -37,12 +39,14 @@ std::string agree(MPI_Comm comm, const std::string& err) {
   return msg;
 }
 
-// Byte offset of every chunk's rows in the file (after the header), from all ranks' sizes.
-std::vector<long long> chunk_offsets(MPI_Comm comm, const ScreenRows& rows, long long nchunks,
+// Offset of every chunk in the file (from `header` on), from all ranks' chunk sizes (bytes or
+// rows; sizes[c] is that of this rank's chunk chunks[c]).
+std::vector<long long> chunk_offsets(MPI_Comm comm, const std::vector<long long>& chunks,
+                                     const std::vector<long long>& sizes, long long nchunks,
                                      long long header) {
   std::vector<long long> size(static_cast<size_t>(nchunks), 0);
-  for (size_t c = 0; c < rows.chunks.size(); ++c)
-    size[static_cast<size_t>(rows.chunks[c])] = rows.sizes[c];
+  for (size_t c = 0; c < chunks.size(); ++c)
+    size[static_cast<size_t>(chunks[c])] = sizes[c];
   // Each chunk belongs to one rank; the sum over ranks assembles the table.
   MPI_Allreduce(MPI_IN_PLACE, size.data(), static_cast<int>(nchunks), MPI_LONG_LONG, MPI_SUM, comm);
   std::vector<long long> off(static_cast<size_t>(nchunks));
@@ -79,13 +83,20 @@ std::string screen_csv_header(const std::vector<std::string>& varied,
   return h + "\n";
 }
 
-void ScreenRows::add(long long index, const std::vector<double>& values, const SetResult& r) {
-  put(text, index);
-  for (double v : values)
-    text += ',', put(text, v);
-  for (double v : {r.wavelength, r.k, r.growth})
-    text += ',', put(text, v);
-  for (double v : r.u)
+void ScreenRows::add(long long set, const std::vector<double>& values, const SetResult& r) {
+  std::vector<double> row = values;
+  row.insert(row.end(), {r.wavelength, r.k, r.growth});
+  row.insert(row.end(), r.u.begin(), r.u.end());
+  ++rows_;
+  if (numbers) {
+    index.push_back(set);
+    columns.resize(row.size());
+    for (size_t c = 0; c < row.size(); ++c)
+      columns[c].push_back(row[c]);
+  }
+  if (!csv) return;
+  put(text, set);
+  for (double v : row)
     text += ',', put(text, v);
   text += '\n';
 }
@@ -93,7 +104,31 @@ void ScreenRows::add(long long index, const std::vector<double>& values, const S
 void ScreenRows::end_chunk(long long chunk) {
   chunks.push_back(chunk);
   sizes.push_back(static_cast<long long>(text.size()) - ended_);
+  counts.push_back(rows_ - rows_ended_);
   ended_ = static_cast<long long>(text.size());
+  rows_ended_ = rows_;
+}
+
+std::string write_screen_h5(MPI_Comm comm, const std::string& path,
+                            const std::vector<std::string>& columns, const ScreenRows& rows,
+                            long long nchunks, const std::string& model) {
+  const auto first = chunk_offsets(comm, rows.chunks, rows.counts, nchunks, 0);
+  long long total = 0;
+  for (long long c : rows.counts)
+    total += c;
+  MPI_Allreduce(MPI_IN_PLACE, &total, 1, MPI_LONG_LONG, MPI_SUM, comm);
+  io::H5TableData d;
+  d.int_names = {"index"};
+  d.ints = {rows.index};
+  d.real_names = columns;
+  d.reals = rows.columns;
+  d.reals.resize(columns.size());
+  for (size_t c = 0; c < rows.chunks.size(); ++c)
+    d.pieces.emplace_back(first[static_cast<size_t>(rows.chunks[c])], rows.counts[c]);
+  std::string names = "index";
+  for (const auto& c : columns)
+    names += "," + c;
+  return io::write_h5_table(comm, path, total, d, {{"model", model}, {"columns", names}});
 }
 
 std::string write_screen_csv(MPI_Comm comm, const std::string& path, const std::string& header,
@@ -103,7 +138,8 @@ std::string write_screen_csv(MPI_Comm comm, const std::string& path, const std::
   const std::string tmp = (std::filesystem::path(path).parent_path() /
                            ("." + std::filesystem::path(path).filename().string() + ".tmp"))
                               .string();
-  const auto off = chunk_offsets(comm, rows, nchunks, static_cast<long long>(header.size()));
+  const auto off =
+      chunk_offsets(comm, rows.chunks, rows.sizes, nchunks, static_cast<long long>(header.size()));
   if (rank == 0) std::remove(tmp.c_str()); // no stale tail from a longer earlier file
   MPI_Barrier(comm);
   MPI_File fh;

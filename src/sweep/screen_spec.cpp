@@ -186,6 +186,12 @@ ScreenSpec read_screen_spec(Options& opt) {
   read_analysis(opt, *s.model, s);
   s.output = opt.string("screen_output", "screen", "output directory of the screen");
   if (s.output.empty()) throw UserError("-screen_output: empty");
+  const std::string format =
+      opt.choice("screen_format", "csv", {"csv", "hdf5", "both"},
+                 "the table of Turing-unstable sets: turing_sets.csv, turing_sets.h5 (one 1-D "
+                 "dataset per column) or both");
+  s.csv = format != "hdf5";
+  s.hdf5 = format != "csv";
   return s;
 }
 

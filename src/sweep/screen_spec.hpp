@@ -9,6 +9,7 @@
 //                                random/lhs: the number of sets, default 10000
 //   -screen_seed S               random/lhs (default 1)
 //   -screen_output DIR           (default screen)
+//   -screen_format csv|hdf5|both  the table's file(s): turing_sets.csv and/or turing_sets.h5
 //   -params_NAME, -D_S           the fixed values: numbers only (defaults: the model's)
 //   -screen_general, -screen_all_states, -screen_k_samples   the analysis (screen_classify.hpp)
 //   -screen_search_<species> lo,hi, -screen_search_points    the steady-state search box (others:
@@ -35,6 +36,7 @@ struct ScreenSpec {
   std::vector<double> params, D; // the fixed values (screened entries overwritten per set)
   ClassifyOptions classify;
   std::string output;
+  bool csv = true, hdf5 = false; // -screen_format
 };
 
 // Collective (every rank reads the same options). Throws UserError.

@@ -8,6 +8,7 @@ import json
 import os
 import sys
 
+import h5py
 import numpy as np
 import pytest
 
@@ -126,6 +127,28 @@ def test_same_table_on_1_and_2_ranks(tmp_path, sampling):
     assert (tmp_path / "other/turing_sets.csv").read_text() != one
 
 
+@pytest.mark.parametrize("ranks", [1, 2, 3])
+def test_hdf5_table_holds_the_csv_rows(tmp_path, ranks):
+    """-screen_format both: turing_sets.h5 has one dataset per CSV column with the same numbers
+    (many chunks dealt over the ranks: 120,000 sets); hdf5 alone writes no CSV."""
+    args = ["screen"] + BRUSSELATOR + ["-screen_points", "300,400"]
+    ok(run(args + ["-screen_format", "both", "-screen_output", "b"], tmp_path, ranks))
+    with open(tmp_path / "b/turing_sets.csv") as f:
+        head = f.readline().strip().split(",")
+    data = np.loadtxt(tmp_path / "b/turing_sets.csv", delimiter=",", skiprows=1)
+    with h5py.File(tmp_path / "b/turing_sets.h5") as f:
+        assert f.attrs["columns"].decode() == ",".join(head)
+        assert f["index"].dtype == np.int64 and len(data) > 10000
+        for c, name in enumerate(head):
+            assert np.array_equal(f[name][...], data[:, c]), name
+    assert json.loads((tmp_path / "b/screen.json").read_text())["table_h5"] == "turing_sets.h5"
+    ok(run(args + ["-screen_format", "hdf5", "-screen_output", "h"], tmp_path, ranks))
+    assert not (tmp_path / "h/turing_sets.csv").exists()
+    with h5py.File(tmp_path / "h/turing_sets.h5") as f, \
+            h5py.File(tmp_path / "b/turing_sets.h5") as g:
+        assert all(np.array_equal(f[n][...], g[n][...]) for n in head)
+
+
 def test_custom_model_screens_like_the_registered_one(tmp_path):
     points = ["-screen_points", "24,30"]
     ok(run(["screen"] + BRUSSELATOR + points + ["-screen_output", "reg"], tmp_path, 2))
@@ -159,6 +182,7 @@ BAD = [
     (["-screen_range_alpha", "1"], "-screen_range_alpha"),
     (["-screen_points", "0"], "-screen_points 0: must be an integer"),
     (["-screen_sampling", "sobol"], "-screen_sampling"),
+    (["-screen_format", "xlsx"], "-screen_format"),
     (["-params_s", "1+x"], "-params_s 1+x: a screen needs a number"),
     (["-D_b", "8 +- 10%"], "-D_b 8 +- 10%: a screen needs a number"),
     (["-screen_rang_beta", "1,2"], "-screen_rang_beta 1,2: unknown option"),

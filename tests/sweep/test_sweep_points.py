@@ -27,7 +27,8 @@ GS_SMALL = ["-grid_n", "32,32", "-grid_L", "0.3125", "-steps", "400", "-png_ever
 def screen(tmp_path):
     ok(run(["screen", "-model", "brusselator", "-D_a", "1", "-D_b", "8", "-screen_params",
             "alpha,beta", "-screen_range_alpha", "1,3", "-screen_range_beta", "2,8",
-            "-screen_points", "12,12", "-screen_output", "scr"], tmp_path, 2))
+            "-screen_points", "12,12", "-screen_format", "both", "-screen_output", "scr"],
+           tmp_path, 2))
     with open(tmp_path / "scr/turing_sets.csv") as f:
         return list(csv.DictReader(f))
 
@@ -52,6 +53,20 @@ def test_sweep_of_a_screens_unstable_sets(tmp_path, ranks):
     with open(tmp_path / "s/sweep.csv") as f:
         head = f.readline()
     assert head.startswith("index,source_index,params_alpha,params_beta,class,")
+
+
+def test_hdf5_table_gives_the_same_points(tmp_path):
+    """The screen's turing_sets.h5 as the points file: the same points, records and fields."""
+    screen(tmp_path)
+    for f in ("csv", "h5"):
+        ok(run(["sweep", BRUS, "-sweep_points", f"scr/turing_sets.{f}", "-sweep_points_max", "3",
+                "-output_dir", f] + BRUS_SMALL, tmp_path, 2))
+    a, b = table(tmp_path / "csv"), table(tmp_path / "h5")
+    assert b["points_file"] == "scr/turing_sets.h5" and b["finished"] == 3
+    for ra, rb in zip(a["records"], b["records"]):
+        assert (ra["params"], ra["source_index"], ra["class"]) == \
+            (rb["params"], rb["source_index"], rb["class"])
+        assert ra["metrics"] == rb["metrics"]
 
 
 def test_listed_points_equal_the_product_sweep_bitwise(tmp_path):
@@ -105,10 +120,17 @@ def test_changed_points_file_is_refused_on_resume(tmp_path):
     ("F,k\n0.03,0.06\n", ["-sweep_axes", "params_F", "-sweep_params_F", "0.1"],
      "-sweep_params_F: not used with -sweep_points"),
     ("F,k\n0.03,7\n", ["-sweep_axes", "params_F,params_k"], "-params_k 7: out of range"),
+    ("h5:F", ["-sweep_axes", "params_F,params_k"], "no column for sweep axis params_k"),
+    ("h5:", ["-sweep_axes", "params_F,params_k"], "no datasets in its root group"),
 ])
 def test_bad_points_input(tmp_path, text, args, needle):
     name = "missing.csv" if text is None else "p.csv"
-    if text is not None:
+    if text is not None and text.startswith("h5:"):  # an HDF5 file with these 1-D datasets
+        name = "p.h5"
+        with h5py.File(tmp_path / name, "w") as f:
+            for col in filter(None, text[3:].split(",")):
+                f[col] = np.array([0.03, 0.04])
+    elif text is not None:
         (tmp_path / name).write_text(text)
     r = run(["sweep", GS, "-sweep_points", name, "-output_dir", "s"] + GS_SMALL + args,
             tmp_path, 2)
