@@ -106,7 +106,7 @@ Setup read_setup(Options& opt, const std::string& base_dir) {
   const long long max_points = opt.integer(
       "sweep_points_max", 0, 0, 10000000,
       "with -sweep_points: at most N points, evenly spaced rows of the file (0: every row)");
-  if (points.empty() && opt.is_set("sweep_points_max"))
+  if (points.empty() && max_points > 0) // 0 (the default) is what options_used.yaml records
     throw UserError("-sweep_points_max " + std::to_string(max_points) +
                     ": needs -sweep_points (a file of points)");
   s.spec = points.empty() ? read_product_axes(opt, s.set.known)
