@@ -53,6 +53,12 @@ def test_sweep_of_a_screens_unstable_sets(tmp_path, ranks):
     with open(tmp_path / "s/sweep.csv") as f:
         head = f.readline()
     assert head.startswith("index,source_index,params_alpha,params_beta,class,")
+    # options_used.yaml reruns as the same listed sweep
+    ok(run(["sweep", str(tmp_path / "s/options_used.yaml"), "-output_dir", "again"], tmp_path,
+           ranks, timeout=300))
+    again = table(tmp_path / "again")
+    assert [(r["params"], r["source_index"], r["class"]) for r in again["records"]] == \
+        [(r["params"], r["source_index"], r["class"]) for r in t["records"]]
 
 
 def test_hdf5_table_gives_the_same_points(tmp_path):
