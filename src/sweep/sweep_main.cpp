@@ -59,13 +59,21 @@ constexpr const char* kAxesHelp =
     "options swept (1 to 3), e.g. params_F,params_k; each needs -sweep_<option> with its values "
     "(with -sweep_points: 1 to 16 columns of the file; default: a screen file's varied ones)";
 
+// -sweep_axes: 1 to `most` distinct options; optional (-sweep_points: the file's own columns
+// then): an empty list when not given.
+std::vector<std::string> read_axis_names(Options& opt, int most, bool optional) {
+  if (optional && !opt.is_set("sweep_axes")) return {};
+  const auto axes = opt.list("sweep_axes", {}, 1, most, kAxesHelp);
+  for (const auto& a : axes)
+    if (std::count(axes.begin(), axes.end(), a) > 1)
+      throw UserError("-sweep_axes: " + a + " is given twice");
+  return axes;
+}
+
 // The axes of a product sweep: -sweep_axes and each axis's -sweep_<option> values.
 SweepSpec read_product_axes(Options& opt, std::vector<std::string>& known) {
   SweepSpec spec;
-  const auto axes = opt.list("sweep_axes", {}, 1, 3, kAxesHelp);
-  for (const auto& a : axes) {
-    if (std::count(axes.begin(), axes.end(), a) > 1)
-      throw UserError("-sweep_axes: " + a + " is given twice");
+  for (const auto& a : read_axis_names(opt, 3, false)) {
     const std::string key = "sweep_" + a;
     const auto text = opt.get(key, "values of " + a +
                                        ": linspace(a, b, n), logspace(a, b, n), "
@@ -85,15 +93,11 @@ SweepSpec read_product_axes(Options& opt, std::vector<std::string>& known) {
 // The axes of a listed sweep: the rows of -sweep_points (point_list.hpp).
 SweepSpec read_listed_axes(Options& opt, const std::string& file, const std::string& base_dir,
                            long long max_points) {
-  const auto axes = opt.is_set("sweep_axes") ? opt.list("sweep_axes", {}, 1, 16, kAxesHelp)
-                                             : std::vector<std::string>();
-  for (const auto& a : axes) {
-    if (std::count(axes.begin(), axes.end(), a) > 1)
-      throw UserError("-sweep_axes: " + a + " is given twice");
+  const auto axes = read_axis_names(opt, 16, true);
+  for (const auto& a : axes)
     if (opt.is_set("sweep_" + a))
       throw UserError("-sweep_" + a + ": not used with -sweep_points " + file + " (the values of " +
                       a + " come from the file)");
-  }
   return read_point_list("sweep_points", resolve_path(base_dir, file), axes, max_points);
 }
 
@@ -101,8 +105,9 @@ Setup read_setup(Options& opt, const std::string& base_dir) {
   Setup s;
   const std::string points =
       opt.string("sweep_points", "",
-                 "CSV file of points, one per row (a header names the columns; e.g. a screen's "
-                 "turing_sets.csv): sweep these instead of the product of the axes' values");
+                 "CSV file (a header names the columns) or HDF5 table of points, one per row, e.g. "
+                 "a screen's turing_sets.csv or .h5: sweep these instead of the product of the "
+                 "axes' values");
   const long long max_points = opt.integer(
       "sweep_points_max", 0, 0, 10000000,
       "with -sweep_points: at most N points, evenly spaced rows of the file (0: every row)");
@@ -300,10 +305,12 @@ int run_sweep(int* argc, char*** argv, const std::vector<OptionsFileArg>& option
       if (std::find(done.begin(), done.end(), p) == done.end()) todo.push_back(p);
     if (err.empty()) {
       std::string axes = s.spec.listed ? "rows of " + s.spec.points_file + ": " : "";
-      for (const auto& ax : s.spec.axes)
-        axes += s.spec.listed ? (ax.option == s.spec.axes[0].option ? "" : ", ") + ax.option
-                              : (ax.option == s.spec.axes[0].option ? "" : " x ") + ax.option +
-                                    "[" + std::to_string(ax.values.size()) + "]";
+      for (size_t a = 0; a < s.spec.axes.size(); ++a) {
+        const Axis& ax = s.spec.axes[a];
+        if (a > 0) axes += s.spec.listed ? ", " : " x ";
+        axes +=
+            s.spec.listed ? ax.option : ax.option + "[" + std::to_string(ax.values.size()) + "]";
+      }
       std::printf("sweep: %lld points (%s), chunk %lld/%lld: %zu to run, %zu already done -> %s/\n",
                   npoints, axes.c_str(), s.chunk, s.chunks, todo.size(), done.size(), dir.c_str());
       std::fflush(stdout);
