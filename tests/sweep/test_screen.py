@@ -127,7 +127,7 @@ def test_same_table_on_1_and_2_ranks(tmp_path, sampling):
     assert (tmp_path / "other/turing_sets.csv").read_text() != one
 
 
-@pytest.mark.parametrize("ranks", [1, 2, 3])
+@pytest.mark.parametrize("ranks", [1, 2, 3, 4])
 def test_hdf5_table_holds_the_csv_rows(tmp_path, ranks):
     """-screen_format both: turing_sets.h5 has one dataset per CSV column with the same numbers
     (many chunks dealt over the ranks: 120,000 sets); hdf5 alone writes no CSV."""

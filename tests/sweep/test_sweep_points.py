@@ -1,4 +1,4 @@
-"""`morphogen sweep` over a list of points (-sweep_points FILE), end to end on 1 and 2 ranks: a
+"""`morphogen sweep` over a list of points (-sweep_points FILE), end to end on 1, 2 and 4 ranks: a
 screen's Turing-unstable sets are simulated and only those, rows evenly chosen by
 -sweep_points_max, each record carrying its index in the file; a listed sweep of given (F, k)
 rows writes the same fields, bit for bit, as the product sweep over those values; a screen run
@@ -33,7 +33,7 @@ def screen(tmp_path):
         return list(csv.DictReader(f))
 
 
-@pytest.mark.parametrize("ranks", [1, 2])
+@pytest.mark.parametrize("ranks", [1, 2, 4])
 def test_sweep_of_a_screens_unstable_sets(tmp_path, ranks):
     rows = screen(tmp_path)
     m = len(rows)
