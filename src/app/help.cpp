@@ -77,7 +77,7 @@ const Conditional kConditional[] = {
      "tensor)"},
     {"split_", "-split_ordering lie|strang",
      "operator splitting order (default strang; with -integrator split)"},
-    {"split_", "-split_reaction euler|heun|backward_euler|trapezoidal",
+    {"split_", "-split_reaction euler|heun|rk4|backward_euler|trapezoidal",
      "reaction substep (default trapezoidal with strang, backward_euler with lie)"},
     {"split_", "-split_diffusion backward_euler|crank_nicolson",
      "diffusion substep (default crank_nicolson with strang, backward_euler with lie)"},

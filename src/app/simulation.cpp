@@ -463,11 +463,13 @@ void Simulation::read_split(Options& opt) {
   const bool strang = set.ordering == SplitOrdering::Strang;
   const std::string rs =
       opt.choice("split_reaction", strang ? "trapezoidal" : "backward_euler",
-                 {"euler", "heun", "backward_euler", "trapezoidal"},
-                 "reaction substep: euler, heun (explicit), backward_euler, trapezoidal "
-                 "(implicit per cell, Newton with the analytic Jacobian)");
+                 {"euler", "heun", "rk4", "backward_euler", "trapezoidal"},
+                 "reaction substep: euler, heun, rk4 (explicit: for reactions that are not "
+                 "stiff at the step), backward_euler, trapezoidal (implicit per cell, Newton with "
+                 "the analytic Jacobian)");
   set.reaction = rs == "euler"            ? ReactionScheme::Euler
                  : rs == "heun"           ? ReactionScheme::Heun
+                 : rs == "rk4"            ? ReactionScheme::Rk4
                  : rs == "backward_euler" ? ReactionScheme::BackwardEuler
                                           : ReactionScheme::Trapezoidal;
   const std::string ds = opt.choice("split_diffusion", strang ? "crank_nicolson" : "backward_euler",

@@ -172,6 +172,9 @@ void set_case(const OptionPairs& opts) {
                                      "-D_b",
                                      "-diffusion",
                                      "-diffusion_solver",
+                                     "-split_reaction",
+                                     "-split_fuse_reaction",
+                                     "-ts_adapt_type",
                                      "-diffusion_pc_type",
                                      "-diffusion_pc_mg_levels",
                                      "-diffusion_pc_mg_galerkin",
@@ -191,7 +194,8 @@ void set_case(const OptionPairs& opts) {
 }
 
 OptionPairs brusselator_deck(int n, const std::string& integrator, const std::string& dt,
-                             const std::string& solver = "auto") {
+                             const std::string& solver = "auto",
+                             const std::string& reaction = "trapezoidal") {
   OptionPairs o = {{"-model", "brusselator"},
                    {"-grid_n", std::to_string(n) + "," + std::to_string(n)},
                    {"-grid_L", std::to_string(1.5 * n)},
@@ -205,7 +209,11 @@ OptionPairs brusselator_deck(int n, const std::string& integrator, const std::st
                    {"-init_b", "3 +- 1%"},
                    {"-integrator", integrator},
                    {"-dt", dt}};
-  if (integrator == "split") o.push_back({"-diffusion_solver", solver});
+  if (integrator == "split") {
+    o.push_back({"-diffusion_solver", solver});
+    o.push_back({"-split_reaction", reaction});
+  }
+  if (integrator == "ts") o.push_back({"-ts_adapt_type", "basic"}); // dt: the first step only
   return o;
 }
 
@@ -255,7 +263,7 @@ void bench_reaction_kernel(MPI_Comm comm) {
     return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
   };
   double best_cpu = 1e30;
-  auto time = [&](bool lockstep, int* its) {
+  auto time = [&](bool lockstep, int* its, ReactionScheme scheme = ReactionScheme::Trapezoidal) {
     double best = 1e30;
     best_cpu = 1e30;
     for (int rep = 0; rep < 5; ++rep) {
@@ -264,11 +272,10 @@ void bench_reaction_kernel(MPI_Comm comm) {
         const double* in[2] = {a.data() + r * n, b.data() + r * n};
         CellSolve w{};
         const int bad =
-            lockstep
-                ? reaction_row_lockstep<M, false>(ReactionScheme::Trapezoidal, n, in, nullptr, p,
-                                                  nullptr, nullptr, 0.05, 1e-12, 20, floor, out, &w)
-                : reaction_row<M, false>(ReactionScheme::Trapezoidal, n, in, nullptr, p, nullptr,
-                                         nullptr, 0.05, 1e-12, 20, floor, out, &w);
+            lockstep ? reaction_row_lockstep<M, false>(scheme, n, in, nullptr, p, nullptr, nullptr,
+                                                       0.05, 1e-12, 20, floor, out, &w)
+                     : reaction_row<M, false>(scheme, n, in, nullptr, p, nullptr, nullptr, 0.05,
+                                              1e-12, 20, floor, out, &w);
         if (bad >= 0) throw UserError("bench: reaction kernel failed");
         *its = std::max(*its, w.iterations);
       }
@@ -285,6 +292,15 @@ void bench_reaction_kernel(MPI_Comm comm) {
               "per_cell_ns=%.1f lockstep_ns=%.1f lockstep_cpu_ns=%.1f speedup=%.1f "
               "newton_its_max=%d target_lockstep_ns<=10 %s\n",
               n * rows, g, l, l_cpu, g / l, its_l, l <= 10.0 ? "met" : "NOT met");
+  // The explicit substeps (-split_reaction heun|rk4), per-cell path against the vectorised row.
+  for (const ReactionScheme scheme : {ReactionScheme::Heun, ReactionScheme::Rk4}) {
+    const double hg = time(false, &its_g, scheme), hl = time(true, &its_l, scheme);
+    PetscPrintf(comm,
+                "split_reaction_kernel model=brusselator scheme=%s dt=0.05 cells=%d "
+                "per_cell_ns=%.1f row_ns=%.1f speedup=%.1f target<=10 %s\n",
+                scheme == ReactionScheme::Heun ? "heun" : "rk4", n * rows, hg, hl, hg / hl,
+                hl <= 10.0 ? "met" : "NOT met");
+  }
 }
 
 // A split step (auto: FFT where it applies, and KSP) against an explicit step on the same grid
@@ -301,14 +317,24 @@ void bench_split_vs_explicit(MPI_Comm comm, Options& opt, int n, int steps) {
                 "split_step_ms=%.3f explicit_step_ms=%.4f ratio=%.1f target_ratio<=10 %s\n",
                 n, n, solver, 1e3 * sp, 1e3 * ex, sp / ex, sp / ex <= 10.0 ? "met" : "NOT met");
   }
-  OptionPairs fused = brusselator_deck(n, "split", "0.1", "auto");
-  fused.push_back({"-split_fuse_reaction", "true"});
-  const double fu = seconds_per_fused_step(comm, opt, fused, steps);
-  PetscPrintf(
-      comm,
-      "split_vs_explicit grid=%dx%d model=brusselator diffusion_solver=auto fused_passes=%d "
-      "split_step_ms=%.3f explicit_step_ms=%.4f ratio=%.1f target_ratio<=10 %s\n",
-      n, n, steps, 1e3 * fu, 1e3 * ex, fu / ex, fu / ex <= 10.0 ? "met" : "NOT met");
+  const double rk =
+      seconds_per_step(comm, opt, brusselator_deck(n, "split", "0.1", "auto", "rk4"), steps);
+  PetscPrintf(comm,
+              "split_vs_explicit grid=%dx%d model=brusselator diffusion_solver=auto "
+              "split_reaction=rk4 split_step_ms=%.3f explicit_step_ms=%.4f ratio=%.1f "
+              "target_ratio<=10 %s\n",
+              n, n, 1e3 * rk, 1e3 * ex, rk / ex, rk / ex <= 10.0 ? "met" : "NOT met");
+  for (const char* reaction : {"trapezoidal", "rk4"}) {
+    OptionPairs fused = brusselator_deck(n, "split", "0.1", "auto", reaction);
+    fused.push_back({"-split_fuse_reaction", "true"});
+    const double fu = seconds_per_fused_step(comm, opt, fused, steps);
+    PetscPrintf(comm,
+                "split_vs_explicit grid=%dx%d model=brusselator diffusion_solver=auto "
+                "split_reaction=%s fused_passes=%d split_step_ms=%.3f explicit_step_ms=%.4f "
+                "ratio=%.1f target_ratio<=10 %s\n",
+                n, n, reaction, steps, 1e3 * fu, 1e3 * ex, fu / ex,
+                fu / ex <= 10.0 ? "met" : "NOT met");
+  }
 }
 
 struct DeckRun {
@@ -366,19 +392,31 @@ void print_deck_run(MPI_Comm comm, double T, const char* tag, double dt, PetscIn
 }
 
 // input/brusselator.yaml to t = T: explicit dt 0.0025 against split dt `split_dt` (species a),
-// plain and with fused Strang passes (-split_fuse_reaction).
-void bench_brusselator_deck(MPI_Comm comm, Options& opt, double T, double split_dt) {
+// plain, with fused Strang passes (-split_fuse_reaction), with the explicit Heun and RK4
+// reaction substeps (-split_reaction heun|rk4: the deck's reaction is not stiff at dt 0.25, its
+// diffusion is), and PETSc TS (ARKIMEX, adaptive steps) beside them.
+void bench_brusselator_deck(MPI_Comm comm, Options& opt, double T, double split_dt, bool with_ts) {
   const PetscInt ex_steps = static_cast<PetscInt>(std::lround(T / 0.0025));
   const PetscInt sp_steps = static_cast<PetscInt>(std::lround(T / split_dt));
   char dt_text[32];
   std::snprintf(dt_text, sizeof dt_text, "%.17g", split_dt);
   const DeckRun ex = run_deck(comm, opt, brusselator_deck(256, "explicit", "0.0025"), ex_steps);
   print_deck_run(comm, T, "explicit", 0.0025, ex_steps, ex);
-  for (const bool fused : {false, true}) {
-    OptionPairs o = brusselator_deck(256, "split", dt_text);
-    if (fused) o.push_back({"-split_fuse_reaction", "true"});
+  struct Variant {
+    const char *tag, *integrator, *reaction;
+    bool fused;
+  };
+  std::vector<Variant> variants = {{"split", "split", "trapezoidal", false},
+                                   {"split_fused", "split", "trapezoidal", true},
+                                   {"split_heun", "split", "heun", false},
+                                   {"split_rk4", "split", "rk4", false},
+                                   {"split_rk4_fused", "split", "rk4", true}};
+  if (with_ts) variants.push_back({"ts", "ts", "", false});
+  for (const Variant& v : variants) {
+    OptionPairs o = brusselator_deck(256, v.integrator, dt_text, "auto", v.reaction);
+    if (v.fused) o.push_back({"-split_fuse_reaction", "true"});
     const DeckRun sp = run_deck(comm, opt, o, sp_steps);
-    const char* tag = fused ? "split_fused" : "split";
+    const char* tag = v.tag;
     print_deck_run(comm, T, tag, split_dt, sp_steps, sp);
     const DeckComparison c = compare_deck_runs(ex, sp);
     PetscPrintf(comm,
@@ -411,6 +449,9 @@ int run(MPI_Comm comm) {
                                  "simulated time of the Brusselator deck comparison (0: skip)");
   const double deck_split_dt = opt.real("bench_brusselator_split_dt", 0.25, 1e-6, 100.0,
                                         "split step of the Brusselator deck comparison");
+  const bool deck_ts =
+      opt.flag("bench_brusselator_ts", true,
+               "also run the Brusselator deck with -integrator ts (ARKIMEX, -ts_adapt_type basic)");
   const bool with_scaling = opt.flag(
       "bench_scaling", true,
       "strong scaling on this node (1 rank vs all) and the weak-scaling model for clusters");
@@ -452,7 +493,7 @@ int run(MPI_Comm comm) {
     bench_split_vs_explicit(comm, opt, 256, static_cast<int>(split_steps) * 4);
     opt.check_unused();
     bench_split_vs_explicit(comm, opt, 1024, static_cast<int>(split_steps));
-    if (deck_T > 0) bench_brusselator_deck(comm, opt, deck_T, deck_split_dt);
+    if (deck_T > 0) bench_brusselator_deck(comm, opt, deck_T, deck_split_dt, deck_ts);
   }
   if (only_implicit) return 0;
   set_case({});

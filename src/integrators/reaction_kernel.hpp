@@ -6,6 +6,9 @@
 //   Euler          v = u + dt (R(u) + S0)                                   (order 1)
 //   Heun (RK2)     k1 = R(u) + S0,  w = u + dt k1,
 //                  v = u + dt/2 (k1 + R(w) + S1)                            (order 2)
+//   Rk4 (classical) k1 = R(u) + S0,  k2 = R(u + dt/2 k1) + Sm,  k3 = R(u + dt/2 k2) + Sm,
+//                  k4 = R(u + dt k3) + S1,  v = u + dt/6 (k1 + 2 k2 + 2 k3 + k4),
+//                  Sm = (S0 + S1)/2       (order 4; 2 where S is not linear in t over a step)
 //   BackwardEuler  F(v) = v - u - dt (R(v) + S1)                      = 0  (order 1, L-stable)
 //   Trapezoidal    F(v) = v - u - dt/2 (R(u) + S0 + R(v) + S1)        = 0  (order 2, A-stable)
 // The implicit rules are the per-cell "implicit update rules" of the stable-ARD paper
@@ -55,7 +58,7 @@
 
 namespace morphogen {
 
-enum class ReactionScheme { Euler, Heun, BackwardEuler, Trapezoidal };
+enum class ReactionScheme { Euler, Heun, Rk4, BackwardEuler, Trapezoidal };
 
 struct CellSolve {
   int iterations = 0;    // Newton iterations (LU solves); 0 for explicit schemes
@@ -162,6 +165,52 @@ inline bool newton_converged(double step, double prev, double bound) {
   return newton_converged_mask(step, prev, bound) != 0.0;
 }
 
+// The explicit schemes (Euler, Heun, Rk4) for one cell, given ru = R(u); s0, s1 the sources
+// (zeros where none). Shared by the per-cell solver and the vectorised rows
+// (reaction_explicit_kernel.hpp), which inline it per lane.
+template <ReactionScheme S, int NS, class Model>
+inline void explicit_cell(const Model& m, const double* u, const double* p, const double* ru,
+                          const double* s0, const double* s1, double dt, double* v) {
+  double k[NS], w[NS], r[NS];
+#pragma GCC unroll 16
+  for (int q = 0; q < NS; ++q) {
+    k[q] = ru[q] + s0[q];
+    w[q] = u[q] + (S == ReactionScheme::Rk4 ? 0.5 * dt : dt) * k[q];
+  }
+  if constexpr (S == ReactionScheme::Euler) {
+#pragma GCC unroll 16
+    for (int q = 0; q < NS; ++q)
+      v[q] = w[q];
+  } else if constexpr (S == ReactionScheme::Heun) {
+    m.rates(w, p, r);
+#pragma GCC unroll 16
+    for (int q = 0; q < NS; ++q)
+      v[q] = u[q] + 0.5 * dt * (k[q] + r[q] + s1[q]);
+  } else {
+    static_assert(S == ReactionScheme::Rk4, "explicit_cell: Euler, Heun or Rk4");
+    double acc[NS], sm[NS];
+    const double c[3] = {0.5 * dt, dt, 0.0}; // the next stage's offset after k2, k3, k4
+#pragma GCC unroll 16
+    for (int q = 0; q < NS; ++q) {
+      acc[q] = k[q];
+      sm[q] = 0.5 * (s0[q] + s1[q]);
+    }
+#pragma GCC unroll 4
+    for (int stage = 0; stage < 3; ++stage) {
+      m.rates(w, p, r);
+#pragma GCC unroll 16
+      for (int q = 0; q < NS; ++q) {
+        k[q] = r[q] + (stage == 2 ? s1[q] : sm[q]);
+        acc[q] += (stage == 2 ? 1.0 : 2.0) * k[q];
+        w[q] = u[q] + c[stage] * k[q];
+      }
+    }
+#pragma GCC unroll 16
+    for (int q = 0; q < NS; ++q)
+      v[q] = u[q] + dt / 6.0 * acc[q];
+  }
+}
+
 } // namespace detail
 
 // One cell: see the header comment. u, S0, S1 and v have M::nspecies entries (S0/S1 may be
@@ -181,21 +230,14 @@ inline CellSolve reaction_cell_of(const Model& m, ReactionScheme scheme, const d
   m.rates(u, p, ru);
   CellSolve out{0, 0.0, false};
 
-  if (scheme == ReactionScheme::Euler) {
-    for (int s = 0; s < NS; ++s)
-      v[s] = u[s] + dt * (ru[s] + s0[s]);
-    out.converged = detail::all_finite<NS>(v);
-    return out;
-  }
-  if (scheme == ReactionScheme::Heun) {
-    double k1[NS], w[NS], rw[NS];
-    for (int s = 0; s < NS; ++s) {
-      k1[s] = ru[s] + s0[s];
-      w[s] = u[s] + dt * k1[s];
-    }
-    m.rates(w, p, rw);
-    for (int s = 0; s < NS; ++s)
-      v[s] = u[s] + 0.5 * dt * (k1[s] + rw[s] + s1[s]);
+  if (scheme == ReactionScheme::Euler || scheme == ReactionScheme::Heun ||
+      scheme == ReactionScheme::Rk4) {
+    if (scheme == ReactionScheme::Euler)
+      detail::explicit_cell<ReactionScheme::Euler, NS>(m, u, p, ru, s0, s1, dt, v);
+    else if (scheme == ReactionScheme::Heun)
+      detail::explicit_cell<ReactionScheme::Heun, NS>(m, u, p, ru, s0, s1, dt, v);
+    else
+      detail::explicit_cell<ReactionScheme::Rk4, NS>(m, u, p, ru, s0, s1, dt, v);
     out.converged = detail::all_finite<NS>(v);
     return out;
   }

@@ -24,34 +24,20 @@
 // LU: a few ulps of the update, far below tol; tests/integrators/test_reaction_lockstep.cpp).
 //
 // reaction_row_lockstep has reaction_row's contract (reaction_kernel.hpp: clamped outputs,
-// -1 or the first failed cell, *worst, out may alias u) and falls back to it for the explicit
-// schemes and for models with other species counts.
+// -1 or the first failed cell, *worst, out may alias u); the explicit schemes go to the
+// vectorised reaction_row_explicit (reaction_explicit_kernel.hpp), models with other species
+// counts to reaction_row.
 #pragma once
 
+#include "integrators/reaction_explicit_kernel.hpp"
 #include "integrators/reaction_kernel.hpp"
+#include "integrators/reaction_lanes.hpp"
 
 #include <cfloat>
 
 namespace morphogen {
 
 namespace detail {
-
-// The lane loops run on 512-bit vectors where the target has them (GCC; the rest of the build
-// prefers 256-bit ones).
-#if defined(__GNUC__) && !defined(__clang__) && defined(__AVX512F__)
-#define MG_LOCKSTEP_WIDE __attribute__((target("prefer-vector-width=512")))
-#else
-#define MG_LOCKSTEP_WIDE
-#endif
-
-inline bool finite_d(double x) {
-  return std::fabs(x) <= DBL_MAX;
-} // false for NaN and inf
-
-// 1.0 where x is finite, 0.0 for NaN and inf (a select, so that the lane loops vectorise).
-inline double finite_mask(double x) {
-  return std::fabs(x) <= DBL_MAX ? 1.0 : 0.0;
-}
 
 // x = A^-1 b for N = 2, 3 (row-major A) by Cramer's rule; returns 1.0, or 0.0 when
 // |det| <= 64 eps ||A||_inf^N (numerically singular; x is then unspecified). Branch-free.
@@ -91,26 +77,14 @@ template <int N> inline bool cramer_solve(const double* A, const double* b, doub
   return cramer_lane<N>(A, b, x) != 0.0;
 }
 
-// The W lanes of one chunk (structure of arrays): inputs, iterate and per-lane state (0/1
-// flags as doubles so that every select vectorises).
-template <int NS, int NP, int W> struct LockstepLanes {
-  double u[NS][W], s0[NS][W], s1[NS][W], p[NP][W];
-  double base[NS][W], v[NS][W], F[NS][W], unorm[W], res[W], its[W], done[W], bad[W], prev[W];
-};
-
 // Start: base, the better of u and the Euler predictor, its residual; lanes with a non-finite
 // start are bad, lanes with a zero residual are done.
 template <class M, int NS, int NP, int W>
-MG_LOCKSTEP_WIDE inline void lockstep_start(LockstepLanes<NS, NP, W>& L, double trap, double cdt) {
+MG_LANES_WIDE inline void lockstep_start(LockstepLanes<NS, NP, W>& L, double trap, double cdt) {
 #pragma GCC ivdep
   for (int l = 0; l < W; ++l) {
     double uc[NS], pc[NP], ru[NS], pred[NS], rp[NS], Fp[NS];
-#pragma GCC unroll 16
-    for (int q = 0; q < NP; ++q)
-      pc[q] = L.p[q][l];
-#pragma GCC unroll 16
-    for (int s = 0; s < NS; ++s)
-      uc[s] = L.u[s][l];
+    lane_inputs(L.u, L.p, l, uc, pc);
     M::rates(uc, pc, ru);
     double un = 0.0, resp = 0.0, resu = 0.0, fin = 0.0, finu = 0.0; // sums: NaN/inf show there
 #pragma GCC unroll 16
@@ -151,17 +125,12 @@ MG_LOCKSTEP_WIDE inline void lockstep_start(LockstepLanes<NS, NP, W>& L, double 
 // One full Newton step on every active lane (branch-free: every lane computes, selects keep
 // the finished ones).
 template <class M, int NS, int NP, int W>
-MG_LOCKSTEP_WIDE inline void lockstep_newton(LockstepLanes<NS, NP, W>& L, double cdt, double tol,
-                                             double big, double it) {
+MG_LANES_WIDE inline void lockstep_newton(LockstepLanes<NS, NP, W>& L, double cdt, double tol,
+                                          double big, double it) {
 #pragma GCC ivdep
   for (int l = 0; l < W; ++l) {
     double vc[NS], pc[NP], J[NS * NS], rhs[NS], dv[NS], vt[NS], r[NS], Ft[NS];
-#pragma GCC unroll 16
-    for (int q = 0; q < NP; ++q)
-      pc[q] = L.p[q][l];
-#pragma GCC unroll 16
-    for (int s = 0; s < NS; ++s)
-      vc[s] = L.v[s][l];
+    lane_inputs(L.v, L.p, l, vc, pc);
     M::jacobian(vc, pc, J);
 #pragma GCC unroll 16
     for (int q = 0; q < NS * NS; ++q)
@@ -223,31 +192,6 @@ inline bool lockstep_any_active(const LockstepLanes<NS, NP, W>& L) {
   return busy != 0.0;
 }
 
-// Loads cells [i0, i0 + w) of the row into the lanes; lanes past the row repeat its last cell.
-// A full chunk (w = W) is plain vectorised copies.
-template <int NS, int NP, int W, bool FieldParams>
-inline void lockstep_load(LockstepLanes<NS, NP, W>& L, int i0, int w, int np,
-                          const double* const* u, const double* const* prow, const double* pconst,
-                          const double* const* S0, const double* const* S1) {
-  for (int s = 0; s < NS; ++s) {
-    const double *us = u[s] + i0, *a = S0 ? S0[s] + i0 : nullptr, *b = S1 ? S1[s] + i0 : nullptr;
-    if (w == W) {
-#pragma GCC ivdep
-      for (int l = 0; l < W; ++l)
-        L.u[s][l] = us[l];
-    } else
-      for (int l = 0; l < W; ++l)
-        L.u[s][l] = us[l < w ? l : w - 1];
-    for (int l = 0; l < W; ++l)
-      L.s0[s][l] = a ? a[l < w ? l : w - 1] : 0.0;
-    for (int l = 0; l < W; ++l)
-      L.s1[s][l] = b ? b[l < w ? l : w - 1] : 0.0;
-  }
-  for (int q = 0; q < np; ++q)
-    for (int l = 0; l < W; ++l)
-      L.p[q][l] = FieldParams ? prow[q][i0 + (l < w ? l : w - 1)] : pconst[q];
-}
-
 // 1.0 when every lane converged in the lockstep (no lane needs the per-cell solver).
 template <int NS, int NP, int W> inline bool lockstep_all_done(const LockstepLanes<NS, NP, W>& L) {
   double d = 1.0;
@@ -288,6 +232,10 @@ inline int reaction_row_lockstep(ReactionScheme scheme, int n, const double* con
   constexpr int W = 16;
   const bool implicit =
       scheme == ReactionScheme::BackwardEuler || scheme == ReactionScheme::Trapezoidal;
+  if (scheme == ReactionScheme::Euler || scheme == ReactionScheme::Heun ||
+      scheme == ReactionScheme::Rk4)
+    return reaction_row_explicit<M, FieldParams>(scheme, n, u, prow, pconst, S0, S1, dt, floor, out,
+                                                 worst);
   if constexpr (NS != 2 && NS != 3)
     return reaction_row<M, FieldParams>(scheme, n, u, prow, pconst, S0, S1, dt, tol, maxit, floor,
                                         out, worst);

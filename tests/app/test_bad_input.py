@@ -34,7 +34,7 @@ CASES = [
     ("diverged", ["-clamp", "false", "-params_s", "5", "-steps", "3000", "-png_every", "0"],
      ["became", "by step", "reduce -dt"]),
     ("split_ordering", ["-integrator", "split", "-split_ordering", "lei"], ["-split_ordering", "lei", "did you mean lie"]),
-    ("split_reaction", ["-integrator", "split", "-split_reaction", "rk4"], ["-split_reaction", "rk4", "allowed euler"]),
+    ("split_reaction", ["-integrator", "split", "-split_reaction", "rk3"], ["-split_reaction", "rk3", "allowed euler"]),
     ("bad_pc_type", ["-integrator", "split", "-diffusion_pc_type", "nonsense"], ["-diffusion_pc_type nonsense: unknown PC type"]),
     ("ksp_diverged", ["-grid_n", "64,64", "-integrator", "split", "-dt", "10", "-diffusion_ksp_max_it", "1", "-steps", "3"],
      ["diffusion solve of species", "DIVERGED_ITS", "after 1 iterations", "at step 1"]),

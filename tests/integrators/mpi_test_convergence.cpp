@@ -208,6 +208,11 @@ const OptionList kStrangFused = {{"integrator", "split"},
                                  {"split_ordering", "strang"},
                                  {"diffusion_ksp_rtol", "1e-12"},
                                  {"split_fuse_reaction", "true"}};
+// Strang with the explicit classical Runge-Kutta reaction substep.
+const OptionList kStrangRk4 = {{"integrator", "split"},
+                               {"split_ordering", "strang"},
+                               {"diffusion_ksp_rtol", "1e-12"},
+                               {"split_reaction", "rk4"}};
 
 } // namespace
 
@@ -227,7 +232,8 @@ TEST(ConvergenceSpace, Strang3DDirichlet) {
   EXPECT_NEAR(space_order("strang-cn 3d dirichlet", {3, true}, kStrang, 6, 2, 1, 0.2), 2.0, 0.1);
 }
 
-// Order in time of every scheme on every geometry: {explicit, Lie, Strang, TS ARKIMEX 2E} x
+// Order in time of every scheme on every geometry: {explicit, Lie, Strang, TS ARKIMEX 2E, Strang
+// fused, Strang with the RK4 reaction} x
 // {2-D, 3-D} x {periodic, Dirichlet}.
 struct TimeCase {
   const char* name;
@@ -242,6 +248,7 @@ const TimeCase kTimeCases[] = {
     {"strang-cn", kStrang, 4, 2.0},
     {"ts-arkimex2e", {{"integrator", "ts"}}, 4, 2.0},
     {"strang-cn-fused", kStrangFused, 4, 2.0},
+    {"strang-cn-rk4", kStrangRk4, 4, 2.0},
 };
 
 class ConvergenceTime
@@ -257,7 +264,7 @@ TEST_P(ConvergenceTime, DesignOrder) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllSchemes, ConvergenceTime,
-                         ::testing::Combine(::testing::Range(0, 5), ::testing::Values(2, 3),
+                         ::testing::Combine(::testing::Range(0, 6), ::testing::Values(2, 3),
                                             ::testing::Bool()));
 
 TEST(ConvergenceSpace, TsArkimex2DDirichlet) {

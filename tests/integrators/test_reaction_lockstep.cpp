@@ -9,10 +9,13 @@
 //     threshold);
 //   - the worst iteration count differs by at most 1;
 //   - a NaN cell and an unsolvable cell are reported at the same index by both, with the cells
-//     before it written.
+//     before it written;
+//   - the explicit schemes (Euler, Heun, Rk4: the vectorised row of reaction_explicit_kernel.hpp)
+//     agree with the per-cell path to an ulp and bitwise with themselves on a shifted row.
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cfloat>
 #include <cmath>
 #include <string>
 #include <tuple>
@@ -163,6 +166,98 @@ TYPED_TEST(LockstepModels, ReportsTheSameFailedCell) {
   EXPECT_EQ(rg1, rl1);
   if (rg1 >= 0) {
     EXPECT_EQ(wg.iterations, wl.iterations);
+  }
+}
+
+// Euler, Heun and Rk4 rows (reaction_explicit_kernel.hpp, reached through reaction_row_lockstep)
+// against the per-cell path: equal to an ulp, in place too (out aliasing u), and bitwise
+// independent of a cell's place in the row; a NaN cell is reported at its index with the cells
+// before it written and those from it on untouched.
+TYPED_TEST(LockstepModels, ExplicitRowsAreBitwiseThePerCellPath) {
+  using M = TypeParam;
+  constexpr int NS = M::nspecies;
+  Row<M> row(37);
+  const std::vector<double> floor(NS, -HUGE_VAL);
+  const auto u = Row<M>::ptrs(row.u), s0 = Row<M>::ptrs(row.s0), s1 = Row<M>::ptrs(row.s1),
+             p = Row<M>::ptrs(row.p);
+  for (ReactionScheme scheme : {ReactionScheme::Euler, ReactionScheme::Heun, ReactionScheme::Rk4})
+    for (bool field : {false, true})
+      for (bool sources : {false, true}) {
+        SCOPED_TRACE(std::string(scheme == ReactionScheme::Heun  ? "Heun"
+                                 : scheme == ReactionScheme::Rk4 ? "Rk4"
+                                                                 : "Euler") +
+                     (field ? " field" : " scalar") + (sources ? " sources" : ""));
+        const double* const* S0 = sources ? s0.data() : nullptr;
+        const double* const* S1 = sources ? s1.data() : nullptr;
+        const double* const* prow = field ? p.data() : nullptr;
+        const double* pconst = field ? nullptr : row.pdef.data();
+        std::vector<std::vector<double>> a(NS, std::vector<double>(37)), b = row.u;
+        std::vector<double*> pa, pb;
+        for (int s = 0; s < NS; ++s) {
+          pa.push_back(a[s].data());
+          pb.push_back(b[s].data());
+        }
+        const double dt = 0.3 / row.jnorm;
+        CellSolve wg{}, wl{};
+        const int rg = field ? reaction_row<M, true>(scheme, 37, u.data(), prow, pconst, S0, S1, dt,
+                                                     1e-12, 20, floor.data(), pa.data(), &wg)
+                             : reaction_row<M, false>(scheme, 37, u.data(), prow, pconst, S0, S1,
+                                                      dt, 1e-12, 20, floor.data(), pa.data(), &wg);
+        const std::vector<const double*> in(pb.begin(), pb.end()); // in place: out aliases u
+        const int rl =
+            field ? reaction_row_lockstep<M, true>(scheme, 37, in.data(), prow, pconst, S0, S1, dt,
+                                                   1e-12, 20, floor.data(), pb.data(), &wl)
+                  : reaction_row_lockstep<M, false>(scheme, 37, in.data(), prow, pconst, S0, S1, dt,
+                                                    1e-12, 20, floor.data(), pb.data(), &wl);
+        EXPECT_EQ(rg, -1);
+        EXPECT_EQ(rl, -1);
+        EXPECT_TRUE(wl.converged);
+        EXPECT_EQ(wl.iterations, 0);
+        for (int s = 0; s < NS; ++s)
+          for (int i = 0; i < 37; ++i) // an ulp: a multiply-add may be contracted differently
+            ASSERT_NEAR(a[s][i], b[s][i],
+                        4.0 * DBL_EPSILON * (std::fabs(a[s][i]) + std::fabs(row.u[s][i])))
+                << "species " << s << " cell " << i;
+        // The same cells as a row starting 5 cells later: bitwise the same values.
+        std::vector<std::vector<double>> c(NS, std::vector<double>(32));
+        std::vector<const double*> in5, p5, a5, b5;
+        std::vector<double*> pc;
+        for (int s = 0; s < NS; ++s) {
+          in5.push_back(row.u[s].data() + 5);
+          a5.push_back(row.s0[s].data() + 5);
+          b5.push_back(row.s1[s].data() + 5);
+          pc.push_back(c[s].data());
+        }
+        for (int q = 0; q < M::nparams; ++q)
+          p5.push_back(row.p[q].data() + 5);
+        const int r5 =
+            field ? reaction_row_lockstep<M, true>(
+                        scheme, 32, in5.data(), p5.data(), nullptr, sources ? a5.data() : nullptr,
+                        sources ? b5.data() : nullptr, dt, 1e-12, 20, floor.data(), pc.data(), &wl)
+                  : reaction_row_lockstep<M, false>(
+                        scheme, 32, in5.data(), nullptr, pconst, sources ? a5.data() : nullptr,
+                        sources ? b5.data() : nullptr, dt, 1e-12, 20, floor.data(), pc.data(), &wl);
+        EXPECT_EQ(r5, -1);
+        for (int s = 0; s < NS; ++s)
+          for (int i = 0; i < 32; ++i)
+            ASSERT_EQ(c[s][i], b[s][i + 5]) << "species " << s << " cell " << i + 5;
+      }
+  row.u[NS - 1][21] = std::nan("");
+  std::vector<std::vector<double>> b(NS, std::vector<double>(37, -7.0));
+  std::vector<double*> pb;
+  for (int s = 0; s < NS; ++s)
+    pb.push_back(b[s].data());
+  const auto un = Row<M>::ptrs(row.u);
+  CellSolve wl{};
+  const int rl = reaction_row_lockstep<M, false>(ReactionScheme::Heun, 37, un.data(), nullptr,
+                                                 row.pdef.data(), nullptr, nullptr, 0.3 / row.jnorm,
+                                                 1e-12, 20, floor.data(), pb.data(), &wl);
+  EXPECT_EQ(rl, 21);
+  EXPECT_FALSE(wl.converged);
+  for (int s = 0; s < NS; ++s) {
+    EXPECT_NE(b[s][20], -7.0);
+    EXPECT_EQ(b[s][21], -7.0);
+    EXPECT_EQ(b[s][36], -7.0);
   }
 }
 
