@@ -4,6 +4,8 @@
 #include "core/options.hpp"
 #include "core/user_error.hpp"
 
+#include <vector>
+
 namespace morphogen {
 
 void fill_field(const Grid& grid, ValueSpec& spec, double* a, ArrayLayout layout, double lo,
@@ -11,10 +13,12 @@ void fill_field(const Grid& grid, ValueSpec& spec, double* a, ArrayLayout layout
   std::string err;
   try {
     const Box& ob = grid.owned();
+    std::vector<double> row(static_cast<size_t>(ob.m[0]));
     for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2] && err.empty(); ++k)
-      for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1] && err.empty(); ++j)
+      for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1] && err.empty(); ++j) {
+        spec.fill_row(ob.s[0], ob.m[0], j, k, t, row.data());
         for (PetscInt i = ob.s[0]; i < ob.s[0] + ob.m[0]; ++i) {
-          const double v = spec.at_cell(i, j, k, t);
+          const double v = row[static_cast<size_t>(i - ob.s[0])];
           if (!(v >= lo && v <= hi)) {
             err = "-" + spec.key() + " " + spec.text() + ": value " + format_double(v) +
                   " at cell (" + std::to_string(i) + "," + std::to_string(j) + "," +
@@ -27,6 +31,7 @@ void fill_field(const Grid& grid, ValueSpec& spec, double* a, ArrayLayout layout
           a[layout == ArrayLayout::Owned ? grid.owned_index(i, j, k) : grid.local_index(i, j, k)] =
               v;
         }
+      }
   } catch (const UserError& e) {
     err = e.what();
   }

@@ -3,6 +3,7 @@
 #include "core/hash_rng.hpp"
 #include "core/options.hpp"
 #include "core/user_error.hpp"
+#include "fields/column_program.hpp"
 #include "fields/strokes_field.hpp"
 
 #include <cmath>
@@ -103,6 +104,14 @@ std::string top_level_problem(const std::string& expr) {
              "function's arguments)";
   }
   return {};
+}
+
+// Polar radius and angle about the domain centre (one out-of-line function, so that the cell
+// and row evaluations round alike).
+[[gnu::noinline]] void polar_of(double x, double y, const GridSpec& g, double* r, double* theta) {
+  const double cx = x - 0.5 * g.L[0], cy = y - 0.5 * g.L[1];
+  *r = std::sqrt(cx * cx + cy * cy);
+  *theta = std::atan2(cy, cx);
 }
 
 // muParser callbacks (user data = the ValueSpec being evaluated).
@@ -249,6 +258,14 @@ ValueSpec::ValueSpec(const std::string& key, const std::string& text, const Grid
         (used.empty() || (used.size() == 1 && uses_t_)) && !cell_funcs && perturb_ == Perturb::None;
     polar_ = used.count("r") > 0 || used.count("theta") > 0;
     base_constant_ = used.empty() && !cell_funcs;
+    if (!cell_funcs && !base_constant_ && mu::ParserVersion.rfind("2.3.", 0) == 0) {
+      P.Eval(); // compiles the bytecode
+      row_ = std::make_unique<ColumnProgram>(P.GetByteCode(), var_, kVars);
+      if (!row_->ok) row_.reset();
+      const char* names[kVars] = {"x", "y", "z", "i", "j", "k", "r", "theta", "t"};
+      for (int v = 0; v < kVars; ++v)
+        used_[v] = used.count(names[v]) > 0;
+    }
     if (base_constant_) base_ = P.Eval(); // the same number Eval() gives at every cell
     if (used.empty() && !cell_funcs && perturb_ == Perturb::None) {
       constant_ = true;
@@ -300,6 +317,10 @@ double ValueSpec::eval_expr() {
   } catch (const mu::Parser::exception_type& e) {
     throw UserError("-" + key_ + " " + text_ + ": " + e.GetMsg() + where());
   }
+  return perturbed(v);
+}
+
+double ValueSpec::perturbed(double v) {
   if (perturb_ != Perturb::None) {
     const double a = percent_ ? amount_ * 0.01 * std::abs(v) : amount_;
     v += perturb_ == Perturb::Uniform ? a * (2.0 * rng::uniform(seed_, stream_, cell_) - 1.0)
@@ -315,11 +336,7 @@ double ValueSpec::at_point(double x, double y, double z, PetscInt i, PetscInt j,
   if (constant_) return value_;
   x_ = x, y_ = y, z_ = z, t_ = t;
   i_ = static_cast<double>(i), j_ = static_cast<double>(j), k_ = static_cast<double>(k);
-  if (polar_) {
-    const double cx = x - 0.5 * grid_.L[0], cy = y - 0.5 * grid_.L[1];
-    r_ = std::sqrt(cx * cx + cy * cy);
-    theta_ = std::atan2(cy, cx);
-  }
+  if (polar_) polar_of(x, y, grid_, &r_, &theta_);
   const auto wrap = [&](PetscInt c, int d) {
     return c >= 0 && c < grid_.n[d] ? c : ((c % grid_.n[d]) + grid_.n[d]) % grid_.n[d];
   };
@@ -335,6 +352,63 @@ double ValueSpec::at_cell(PetscInt i, PetscInt j, PetscInt k, double t) {
   const double y = (static_cast<double>(j) + 0.5) * grid_.h(1);
   const double z = grid_.dim == 3 ? (static_cast<double>(k) + 0.5) * grid_.h(2) : 0.0;
   return at_point(x, y, z, i, j, k, t);
+}
+
+// The variables' columns of cells [i0, i0 + n) of row (j, k) at time t (only those read).
+void ValueSpec::fill_columns(PetscInt i0, PetscInt n, PetscInt j, PetscInt k, double t) {
+  const double y = (static_cast<double>(j) + 0.5) * grid_.h(1);
+  const double z = grid_.dim == 3 ? (static_cast<double>(k) + 0.5) * grid_.h(2) : 0.0;
+  const double fixed[kVars] = {0, y, z, 0, static_cast<double>(j), static_cast<double>(k), 0, 0, t};
+  const bool polar = used_[6] || used_[7];
+  for (int v = 0; v < kVars; ++v) {
+    double* c = cols_.data() + static_cast<size_t>(v) * cap_;
+    if (!used_[v] && !(v == 0 && polar)) continue;
+    for (PetscInt q = 0; q < n; ++q) {
+      const double i = static_cast<double>(i0 + q);
+      c[q] = v == 0 ? (i + 0.5) * grid_.h(0) : v == 3 ? i : fixed[v];
+    }
+  }
+  if (polar)
+    for (PetscInt q = 0; q < n; ++q)
+      polar_of(cols_[static_cast<size_t>(q)], y, grid_, &cols_[6 * cap_ + static_cast<size_t>(q)],
+               &cols_[7 * cap_ + static_cast<size_t>(q)]);
+}
+
+void ValueSpec::fill_row(PetscInt i0, PetscInt n, PetscInt j, PetscInt k, double t, double* out) {
+  if (constant_) {
+    std::fill(out, out + n, value_);
+    return;
+  }
+  if (!row_ && !base_constant_) {
+    for (PetscInt q = 0; q < n; ++q)
+      out[q] = at_cell(i0 + q, j, k, t);
+    return;
+  }
+  if (base_constant_) { // a number and a perturbation: no variables to set
+    std::fill(out, out + n, base_);
+  } else {
+    if (static_cast<size_t>(n) > cap_) {
+      cap_ = static_cast<size_t>(n);
+      cols_.assign(kVars * cap_, 0.0);
+      stack_.assign(static_cast<size_t>(row_->depth) * cap_, 0.0);
+    }
+    fill_columns(i0, n, j, k, t);
+    const double* col[kVars];
+    for (int v = 0; v < kVars; ++v)
+      col[v] = cols_.data() + static_cast<size_t>(v) * cap_;
+    row_->eval(static_cast<int>(n), col, stack_.data(), cap_, out);
+  }
+  const std::uint64_t first =
+      static_cast<std::uint64_t>(i0) +
+      static_cast<std::uint64_t>(grid_.n[0]) *
+          (static_cast<std::uint64_t>(j) +
+           static_cast<std::uint64_t>(grid_.n[1]) * static_cast<std::uint64_t>(k));
+  j_ = static_cast<double>(j), k_ = static_cast<double>(k);
+  for (PetscInt q = 0; q < n; ++q) {
+    cell_ = first + static_cast<std::uint64_t>(q);
+    i_ = static_cast<double>(i0 + q);
+    out[q] = perturbed(out[q]);
+  }
 }
 
 } // namespace morphogen

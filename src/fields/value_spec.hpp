@@ -38,6 +38,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace mu {
 class Parser;
@@ -45,7 +46,8 @@ class Parser;
 
 namespace morphogen {
 struct StrokeField;
-}
+struct ColumnProgram;
+} // namespace morphogen
 
 namespace morphogen {
 
@@ -82,10 +84,16 @@ public:
   double at_cell(PetscInt i, PetscInt j, PetscInt k, double t = 0.0);
   // Value at an arbitrary point (x, y, z); (i, j, k) name the cell whose deviates are used.
   double at_point(double x, double y, double z, PetscInt i, PetscInt j, PetscInt k, double t = 0.0);
+  // out[c] = at_cell(i0 + c, j, k, t) for c in [0, n), bitwise; cells inside the grid. An
+  // expression of muParser's own operators and functions is evaluated a row at a time
+  // (fields/column_program.hpp), not cell by cell; a UserError names the first bad cell.
+  void fill_row(PetscInt i0, PetscInt n, PetscInt j, PetscInt k, double t, double* out);
 
 private:
   friend struct ValueSpecFunctions;
   double eval_expr();
+  double perturbed(double v); // v with this cell's perturbation; a UserError if not finite
+  void fill_columns(PetscInt i0, PetscInt n, PetscInt j, PetscInt k, double t);
   void load_strokes(const std::string& expr);
   std::string where() const;
 
@@ -102,9 +110,18 @@ private:
   enum class Perturb { None, Uniform, Gauss } perturb_ = Perturb::None;
   double amount_ = 0.0;
   bool percent_ = false;
-  // muParser variables and the cell being evaluated.
-  double x_ = 0, y_ = 0, z_ = 0, i_ = 0, j_ = 0, k_ = 0, r_ = 0, theta_ = 0, t_ = 0;
+  // muParser variables (one array, as ColumnProgram reads them) and the cell being evaluated.
+  static constexpr int kVars = 9;
+  double var_[kVars] = {};
+  double &x_ = var_[0], &y_ = var_[1], &z_ = var_[2], &i_ = var_[3], &j_ = var_[4], &k_ = var_[5],
+         &r_ = var_[6], &theta_ = var_[7], &t_ = var_[8];
   std::uint64_t cell_ = 0;
+  // Row evaluation: the bytecode (null where the expression has cell-dependent functions), the
+  // variables it reads, and the scratch columns (kVars and its stack, cap_ cells each).
+  std::unique_ptr<ColumnProgram> row_;
+  bool used_[kVars] = {};
+  std::vector<double> cols_, stack_;
+  size_t cap_ = 0;
   std::map<std::string, io::GreyImage> images_;
   // Stroke fields named in strokes(...) (key "file") and strokes_directed(...) (key "@file").
   std::map<std::string, std::shared_ptr<const StrokeField>> strokes_;
