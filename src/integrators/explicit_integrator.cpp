@@ -294,6 +294,11 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
     const PetscInt bytes_per_row = 3 * ns_ * gx * static_cast<PetscInt>(sizeof(double));
     jblock = std::max<PetscInt>(4, (256 * 1024) / bytes_per_row - 2);
   }
+  // With scalar parameters into a second state set (no ring), one call sweeps all rows of a
+  // block (the kernel steps the row pointers by the ghosted row length): small grids spend less
+  // on per-call setup. Same arithmetic per cell either way.
+  const bool multi = !in_place && !field_mode && !by_class_;
+  row.src_stride = row.dst_stride = gx;
   for (PetscInt jb = ob.s[1]; jb < ob.s[1] + ob.m[1]; jb += jblock)
     for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
       for (PetscInt j = jb; j < std::min(jb + jblock, ob.s[1] + ob.m[1]); ++j) {
@@ -302,6 +307,11 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
           for (int r = 0; r < nr; ++r)
             src[s * nr + r] = in[s] + c + delta[r];
           dst[s] = in_place ? ring_row(s, j) : out[s] + c;
+        }
+        if (multi) {
+          row.rows = static_cast<int>(std::min(jb + jblock, ob.s[1] + ob.m[1]) - j);
+          row_fn_(row);
+          break;
         }
         if (field_mode) {
           const PetscInt o = grid_.owned_index(ob.s[0], j, k);

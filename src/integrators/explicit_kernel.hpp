@@ -38,6 +38,10 @@ struct ExplicitRow {
   // 9-row box stencils only: the weights by class (grid/stencil.hpp, BoxClasses: centre, face,
   // edge, corner) with src in class order, or null for the general 27-tap form of w.
   const double* wclass = nullptr;
+  // Consecutive rows in one call (explicit_row with scalar parameters only): row j reads
+  // src[q] + j src_stride and writes dst[s] + j dst_stride; one call per row otherwise.
+  int rows = 1;
+  long src_stride = 0, dst_stride = 0;
 };
 
 // The two x-profiles of explicit_row_box_classes for x = x0 .. x0 + len - 1 of one species'
@@ -167,31 +171,38 @@ inline void explicit_row(const ExplicitRow& a) {
   }
   const double dt = a.dt;
   const int n = a.n;
+  const int rows = FieldParams ? 1 : a.rows;
+  for (int j = 0; j < rows; ++j) {
 #pragma GCC ivdep
-  for (int i = 0; i < n; ++i) {
-    double u[NS], r[NS], p[NP > 0 ? NP : 1];
-    for (int q = 0; q < NP; ++q) {
-      if constexpr (FieldParams)
-        p[q] = prow[q][i];
-      else
-        p[q] = pc[q];
-    }
-    for (int s = 0; s < NS; ++s)
-      u[s] = src[s * NR][i];
-    M::rates(u, p, r);
-    for (int s = 0; s < NS; ++s) {
-      const double* __restrict__ c = src[s * NR];
-      double lap = w[0][0] * c[i - 1] + w[0][1] * u[s] + w[0][2] * c[i + 1];
-      for (int q = 1; q < NR; ++q) {
-        const double* __restrict__ row = src[s * NR + q];
-        if constexpr (Box)
-          lap += w[q][0] * row[i - 1] + w[q][1] * row[i] + w[q][2] * row[i + 1];
+    for (int i = 0; i < n; ++i) {
+      double u[NS], r[NS], p[NP > 0 ? NP : 1];
+      for (int q = 0; q < NP; ++q) {
+        if constexpr (FieldParams)
+          p[q] = prow[q][i];
         else
-          lap += w[q][1] * row[i];
+          p[q] = pc[q];
       }
-      const double v = u[s] + dt * (D[s] * lap + r[s]);
-      dst[s][i] = clamp_to_floor(v, floor[s]);
+      for (int s = 0; s < NS; ++s)
+        u[s] = src[s * NR][i];
+      M::rates(u, p, r);
+      for (int s = 0; s < NS; ++s) {
+        const double* __restrict__ c = src[s * NR];
+        double lap = w[0][0] * c[i - 1] + w[0][1] * u[s] + w[0][2] * c[i + 1];
+        for (int q = 1; q < NR; ++q) {
+          const double* __restrict__ row = src[s * NR + q];
+          if constexpr (Box)
+            lap += w[q][0] * row[i - 1] + w[q][1] * row[i] + w[q][2] * row[i + 1];
+          else
+            lap += w[q][1] * row[i];
+        }
+        const double v = u[s] + dt * (D[s] * lap + r[s]);
+        dst[s][i] = clamp_to_floor(v, floor[s]);
+      }
     }
+    for (int q = 0; q < NS * NR; ++q)
+      src[q] += a.src_stride;
+    for (int s = 0; s < NS; ++s)
+      dst[s] += a.dst_stride;
   }
 }
 
