@@ -299,19 +299,16 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
   // on per-call setup. Same arithmetic per cell either way.
   const bool multi = !in_place && !field_mode && !by_class_;
   row.src_stride = row.dst_stride = gx;
-  for (PetscInt jb = ob.s[1]; jb < ob.s[1] + ob.m[1]; jb += jblock)
+  for (PetscInt jb = ob.s[1]; jb < ob.s[1] + ob.m[1]; jb += jblock) {
+    const PetscInt jend = std::min(jb + jblock, ob.s[1] + ob.m[1]);
     for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
-      for (PetscInt j = jb; j < std::min(jb + jblock, ob.s[1] + ob.m[1]); ++j) {
+      for (PetscInt j = jb; j < jend; j += row.rows) {
+        row.rows = multi ? static_cast<int>(jend - j) : 1;
         const PetscInt c = grid_.local_index(ob.s[0], j, k);
         for (int s = 0; s < ns_; ++s) {
           for (int r = 0; r < nr; ++r)
             src[s * nr + r] = in[s] + c + delta[r];
           dst[s] = in_place ? ring_row(s, j) : out[s] + c;
-        }
-        if (multi) {
-          row.rows = static_cast<int>(std::min(jb + jblock, ob.s[1] + ob.m[1]) - j);
-          row_fn_(row);
-          break;
         }
         if (field_mode) {
           const PetscInt o = grid_.owned_index(ob.s[0], j, k);
@@ -321,6 +318,7 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
         row_fn_(row);
         if (in_place && j - reach >= ob.s[1]) commit_row(in, j - reach);
       }
+  }
   if (in_place)
     for (PetscInt j = std::max(ob.s[1], ob.s[1] + ob.m[1] - reach); j < ob.s[1] + ob.m[1]; ++j)
       commit_row(in, j);

@@ -38,8 +38,9 @@ struct ExplicitRow {
   // 9-row box stencils only: the weights by class (grid/stencil.hpp, BoxClasses: centre, face,
   // edge, corner) with src in class order, or null for the general 27-tap form of w.
   const double* wclass = nullptr;
-  // Consecutive rows in one call (explicit_row with scalar parameters only): row j reads
-  // src[q] + j src_stride and writes dst[s] + j dst_stride; one call per row otherwise.
+  // Consecutive rows in one call: row j reads src[q] + j src_stride and writes
+  // dst[s] + j dst_stride. Only explicit_row with scalar parameters and without wclass reads
+  // it (the other kernels sweep one row; callers set rows = 1 for them).
   int rows = 1;
   long src_stride = 0, dst_stride = 0;
 };
