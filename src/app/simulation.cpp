@@ -645,8 +645,9 @@ void Simulation::read_fuse(Options& opt) {
   integrator_->set_fuse_steps(static_cast<int>(k));
   const std::string in_place = opt.choice(
       "explicit_in_place", "auto", {"auto", "yes", "no"},
-      "2-D fast path: update the state in place, with no second state set (8 bytes per cell and "
-      "species less); auto: where a rank's state is at least 8 MiB; the same results");
+      "fast path (2-D and 3-D): update the state in place, with no second state set (8 bytes per "
+      "cell and species less); auto: where a rank's state is at least 8 MiB (3-D: 64 MiB); "
+      "the same results");
   integrator_->set_in_place(in_place == "yes"  ? ExplicitIntegrator::InPlace::Always
                             : in_place == "no" ? ExplicitIntegrator::InPlace::Never
                                                : ExplicitIntegrator::InPlace::Auto);

@@ -1,6 +1,7 @@
-// morphogen-bench: explicit Gray-Scott cell-updates per second at 1024^2 (2-D) and 128^3 (3-D)
-// against a STREAM triad measured in the same process, printed as the fraction of the memory
-// bandwidth roofline (32 bytes per 2-species cell-update in double: read u, v; write u, v).
+// morphogen-bench: explicit Gray-Scott cell-updates per second at 1024^2 (2-D) and 128^3 (3-D;
+// -bench_3d_n 256 for out of cache) against a STREAM triad measured in the same process, printed
+// as the fraction of the memory bandwidth roofline (32 bytes per 2-species cell-update in double:
+// read u, v; write u, v).
 // Also times the halo-only update used by the integrator against PETSc's full
 // DMGlobalToLocal copy, and the general explicit path (diffusion tensor, diffusion map) with its
 // own bytes per update and its ratio to the fused path, and Gray-Scott written as a custom model
@@ -432,7 +433,9 @@ int run(MPI_Comm comm) {
   MPI_Comm_size(comm, &size);
   Options opt(comm);
   const PetscInt steps2 = opt.integer("bench_steps_2d", 200, 1, 1000000, "timed steps at 1024^2");
-  const PetscInt steps3 = opt.integer("bench_steps_3d", 50, 1, 1000000, "timed steps at 128^3");
+  const PetscInt steps3 = opt.integer("bench_steps_3d", 50, 1, 1000000, "timed steps in 3-D");
+  const PetscInt n3 = opt.integer("bench_3d_n", 128, 8, 1024,
+                                  "grid side of the 3-D cases (256: out of cache in 3-D)");
   const PetscInt steps_custom = opt.integer("bench_steps_custom", 20, 1, 1000000,
                                             "timed steps of the custom-model case at 1024^2");
   const bool with_split =
@@ -500,16 +503,19 @@ int run(MPI_Comm comm) {
   const Result r2 = bench_explicit(comm, opt, "1024,1024", static_cast<int>(steps2));
   opt.check_unused();
   report("2d", "1024x1024", r2);
-  const Result r3 = bench_explicit(comm, opt, "128,128,128", static_cast<int>(steps3));
-  report("3d", "128x128x128", r3);
+  const std::string side3 = std::to_string(n3);
+  const std::string grid3 = side3 + "," + side3 + "," + side3,
+                    name3 = side3 + "x" + side3 + "x" + side3;
+  const Result r3 = bench_explicit(comm, opt, grid3, static_cast<int>(steps3));
+  report("3d", name3.c_str(), r3);
   // The isotropic 3-D box stencils: the same bytes per update, 19 or 27 taps per species.
   for (const char* st : {"19pt", "27pt"}) {
     const Result rb =
-        bench_explicit(comm, opt, "128,128,128", static_cast<int>(steps3), {{"-stencil", st}});
+        bench_explicit(comm, opt, grid3, static_cast<int>(steps3), {{"-stencil", st}});
     PetscPrintf(comm,
-                "explicit_3d_%s grid=128x128x128 model=gray_scott bytes_per_update=32 "
+                "explicit_3d_%s grid=%s model=gray_scott bytes_per_update=32 "
                 "cell_updates_per_s=%.4e fraction=%.3f vs_7pt=%.3f\n",
-                st, rb.cups, rb.cups / roof, rb.cups / r3.cups);
+                st, name3.c_str(), rb.cups, rb.cups / roof, rb.cups / r3.cups);
   }
   // The general path (diffusion from per-species operators, then the reaction, row by row):
   // a rotated tensor for both species (reads 3 dual-cell tensor components per species: 80

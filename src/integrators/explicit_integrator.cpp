@@ -17,7 +17,7 @@ ExplicitIntegrator::ExplicitIntegrator(const Grid& grid, const Halo& halo, RowFn
       floor_(std::move(floor)), params_(params), dirichlet_(dirichlet) {
   to_rows(stencil_, rows_);
   by_class_ = box_classes(rows_, classes_); // 19pt, 27pt: weight classes, rows in class order
-  ring_depth_ = reach_y() + 1;
+  ring_depth_ = static_cast<int>(reach(1) * grid.owned().m[1]) + reach(0) + 1;
   ring_n_ = static_cast<size_t>(grid.owned().m[0]);
   if (params_.any_field())
     params_.expand_scalars(static_cast<size_t>(grid.owned().m[0]), const_rows_);
@@ -221,26 +221,27 @@ void ExplicitIntegrator::step(std::vector<VecH>& u, std::vector<VecH>& work, dou
 }
 
 bool ExplicitIntegrator::in_place() const {
-  if (!ops_.empty() || grid_.dim() != 2 || in_place_ == InPlace::Never) return false;
+  if (!ops_.empty() || in_place_ == InPlace::Never) return false;
   const double bytes = 8.0 * ns_ * static_cast<double>(grid_.owned().size());
-  return in_place_ == InPlace::Always || bytes >= kInPlaceBytes;
+  return in_place_ == InPlace::Always ||
+         bytes >= (grid_.dim() == 3 ? kInPlaceBytes3d : kInPlaceBytes);
 }
 
-// In-place sweeps: the rows last read by row j are those of rows j - R .. j + R (R: the stencil's
-// reach in y), so the new row j - R can be written into u once row j is computed. New rows wait
-// in a ring of R + 1 row buffers per species.
-int ExplicitIntegrator::reach_y() const {
+// In-place sweeps (header comment): the old row t is last read by row t + R_z ny + R_y.
+int ExplicitIntegrator::reach(int axis) const {
   int r = 0;
   for (int q = 0; q < rows_.nrows; ++q)
-    r = std::max(r, std::abs(rows_.off[q][0]));
+    r = std::max(r, std::abs(rows_.off[q][axis]));
   return r;
 }
 
-// Copies the new row j (owned part, 2-D) from the ring into u.
-void ExplicitIntegrator::commit_row(const std::vector<PetscScalar*>& u, PetscInt j) const {
+// Copies the new row t (sweep order, owned part) from the ring into u.
+void ExplicitIntegrator::commit_row(const std::vector<PetscScalar*>& u, PetscInt t) const {
   const Box& ob = grid_.owned();
+  const PetscInt dk = t / ob.m[1], dj = t - dk * ob.m[1];
   for (int s = 0; s < ns_; ++s)
-    std::copy_n(ring_row(s, j), ob.m[0], u[s] + grid_.local_index(ob.s[0], j, ob.s[2]));
+    std::copy_n(ring_row(s, t), ob.m[0],
+                u[s] + grid_.local_index(ob.s[0], ob.s[1] + dj, ob.s[2] + dk));
 }
 
 void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, double dt) const {
@@ -287,10 +288,11 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
   row.dst = dst.data();
   row.wclass = by_class_ ? classes_.w.data() : nullptr;
   // In 3-D, sweep the box in blocks of y rows so that the three z planes a row reads stay in
-  // the per-core L2 cache (about 256 KiB of state per block); in 2-D one block is the box.
+  // the per-core L2 cache (about 256 KiB of state per block); in 2-D and in place (whose ring
+  // needs the plain order t = (k - k0) ny + j - j0) one block is the box.
   PetscInt jblock = ob.m[1];
-  const int reach = ring_depth_ - 1;
-  if (grid_.dim() == 3) {
+  const PetscInt lag = ring_depth_ - 1;
+  if (grid_.dim() == 3 && !in_place) {
     const PetscInt bytes_per_row = 3 * ns_ * gx * static_cast<PetscInt>(sizeof(double));
     jblock = std::max<PetscInt>(4, (256 * 1024) / bytes_per_row - 2);
   }
@@ -305,10 +307,11 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
       for (PetscInt j = jb; j < jend; j += row.rows) {
         row.rows = multi ? static_cast<int>(jend - j) : 1;
         const PetscInt c = grid_.local_index(ob.s[0], j, k);
+        const PetscInt t = row_order(j, k);
         for (int s = 0; s < ns_; ++s) {
           for (int r = 0; r < nr; ++r)
             src[s * nr + r] = in[s] + c + delta[r];
-          dst[s] = in_place ? ring_row(s, j) : out[s] + c;
+          dst[s] = in_place ? ring_row(s, t) : out[s] + c;
         }
         if (field_mode) {
           const PetscInt o = grid_.owned_index(ob.s[0], j, k);
@@ -316,12 +319,14 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
             prow[q] = pf[q] ? pf[q] + o : const_rows_[q].data();
         }
         row_fn_(row);
-        if (in_place && j - reach >= ob.s[1]) commit_row(in, j - reach);
+        if (in_place && t >= lag) commit_row(in, t - lag);
       }
   }
-  if (in_place)
-    for (PetscInt j = std::max(ob.s[1], ob.s[1] + ob.m[1] - reach); j < ob.s[1] + ob.m[1]; ++j)
-      commit_row(in, j);
+  if (in_place) {
+    const PetscInt tend = ob.m[1] * ob.m[2];
+    for (PetscInt t = std::max<PetscInt>(0, tend - lag); t < tend; ++t)
+      commit_row(in, t);
+  }
 
   for (int q = 0; q < np; ++q)
     if (pf[q]) MG_PETSC(VecRestoreArrayRead(params_.field[q], &pf[q]));

@@ -4,12 +4,14 @@
 //
 // The driver owns communication: halo update of every species (begin all, end all, then the
 // physical boundaries), then one pass over the owned box calling the model's fused row kernel
-// (explicit_kernel.hpp) for each grid row. State lives in ghosted local Vecs. In 2-D the fast
-// path updates them in place where a rank's state is large (set_in_place): each new row waits in a
-// ring of R + 1 row buffers (R: the stencil's reach in y) until the rows reading it are done, so
-// there is no second state set (8 bytes per cell and species less) and the sweep moves 16 bytes per
-// cell and species (no write-allocate of a second array). Otherwise (3-D, the general path, fused
-// steps) the new state is written into a second set, and the two are swapped (no global-to-local
+// (explicit_kernel.hpp) for each grid row. State lives in ghosted local Vecs. The fast path
+// updates them in place where a rank's state is large (set_in_place): rows are swept in the order
+// t = k ny + j, and the old row t is last read by row t + R_z ny + R_y (R: the stencil's reach in
+// y and z), so each new row waits in a ring of R_z ny + R_y + 1 row buffers (2-D: R_y + 1 rows,
+// 3-D: about one plane) until the rows reading it are done. There is no second state set (8 bytes
+// per cell and species less) and the sweep moves 16 bytes per cell and species (no write-allocate
+// of a second array). Otherwise (small states, the general path, fused steps) the new state is
+// written into a second set, and the two are swapped (no global-to-local
 // copy). The step is stable for dt <= 2 / (D_max * spectral_radius(L)) (the diffusion bound, dt <=
 // h^2 / (2 dim D_max) for the 5/7-point Laplacian). General path (any species with a diffusion
 // field or tensor): per grid row, each species' diffusion (DiffusionOperator::apply_row) goes into
@@ -72,11 +74,13 @@ public:
   void use_operators(std::vector<const DiffusionOperator*> ops, PreFn pre_fn);
   bool general() const { return !ops_.empty(); }
 
-  // The 2-D fast path's in-place update (see the header comment): Auto where a rank's state is
-  // at least kInPlaceBytes (out of cache: the memory matters, the row copies hide behind the
-  // memory traffic), else a second state set; Always and Never force it (the same results).
+  // The fast path's in-place update (see the header comment): Auto where a rank's state is
+  // at least kInPlaceBytes (2-D) or kInPlaceBytes3d (3-D, whose ring is a plane: in cache its
+  // copies cost more than in 2-D), where the memory matters and the row copies hide behind the
+  // memory traffic; else a second state set. Always and Never force it (the same results).
   enum class InPlace { Auto, Always, Never };
   static constexpr double kInPlaceBytes = 8.0 * 1024 * 1024;
+  static constexpr double kInPlaceBytes3d = 64.0 * 1024 * 1024;
   void set_in_place(InPlace mode) { in_place_ = mode; }
 
   // Temporal blocking: up to k >= 1 steps per pass (1: one step per pass, the default).
@@ -94,13 +98,19 @@ private:
   // work == nullptr: in place (in_place()).
   void sweep(std::vector<VecH>& u, std::vector<VecH>* work, double dt) const;
   bool in_place() const;
-  int reach_y() const;
-  double* ring_row(int s, PetscInt j) const {
+  int reach(int axis) const; // the stencil's reach in y (axis 0) or z (axis 1)
+  // Row (j, k) in sweep order: t = (k - k0) ny + (j - j0) (owned rows j0 .. j0 + ny - 1 of
+  // planes k0 ..); the ring slot is t mod its depth.
+  PetscInt row_order(PetscInt j, PetscInt k) const {
+    const Box& ob = grid_.owned();
+    return (k - ob.s[2]) * ob.m[1] + (j - ob.s[1]);
+  }
+  double* ring_row(int s, PetscInt t) const {
     return ring_.data() + (static_cast<size_t>(s) * ring_depth_ +
-                           static_cast<size_t>(j) % static_cast<size_t>(ring_depth_)) *
+                           static_cast<size_t>(t) % static_cast<size_t>(ring_depth_)) *
                               ring_n_;
   }
-  void commit_row(const std::vector<PetscScalar*>& u, PetscInt j) const;
+  void commit_row(const std::vector<PetscScalar*>& u, PetscInt t) const;
   void add_other_terms(std::vector<VecH>& u, double t, double dt);
   void step_general(std::vector<VecH>& u, std::vector<VecH>& work, double dt) const;
 
@@ -123,8 +133,8 @@ private:
   std::vector<const Term*> others_;    // terms evaluated through add_rates
   bool constrain_after_sweep_ = false; // constraints other than the kernel's clamp floor
   std::vector<VecH> work_;             // second state set (created when first needed)
-  mutable std::vector<double> ring_;   // in-place sweeps: [ns][R + 1][nx] new rows
-  int ring_depth_ = 2;                 // R + 1
+  mutable std::vector<double> ring_;   // in-place sweeps: [ns][depth][nx] new rows
+  int ring_depth_ = 2;                 // R_z ny + R_y + 1
   size_t ring_n_ = 0;                  // owned cells per row
   InPlace in_place_ = InPlace::Auto;
   std::vector<std::vector<double>> rates_; // owned layout, per species (other terms)

@@ -1,10 +1,11 @@
-"""The 2-D explicit fast path's in-place update (-explicit_in_place; integrators/
+"""The explicit fast path's in-place update (-explicit_in_place; integrators/
 explicit_integrator.hpp: new rows wait in a ring of row buffers until the rows reading them are
 done) gives the same bytes as the sweep into a second state set, on 1, 2 and 4 ranks: 5-point
-and 9-point stencils, periodic, zero-flux and Dirichlet boundaries, per-cell parameters,
-sources, pinned cells, and grids whose rank blocks are a single row. `auto` chooses in place
-only where a rank's state is at least 8 MiB (the run's memory matters; in cache the row copies
-cost more than the write-allocate they save)."""
+and 9-point stencils in 2-D, 7-, 19- and 27-point stencils in 3-D (where the ring is about a
+plane), periodic, zero-flux and Dirichlet boundaries, per-cell and scalar parameters, sources,
+pinned cells, and grids whose rank blocks are a single row. `auto` chooses in place only
+where a rank's state is at least 8 MiB, 64 MiB in 3-D (the run's memory matters; in cache the
+row copies cost more than the write-allocate they save)."""
 import os
 
 import h5py
@@ -14,6 +15,8 @@ import pytest
 from conftest import SOURCE, run
 
 DECK = os.path.join(SOURCE, "input", "turing_spots.yaml")
+DECK_3D = os.path.join(SOURCE, "input", "turing_spots_3d.yaml")
+GS_DECK = os.path.join(SOURCE, "input", "gray_scott_pearson_spots.yaml")  # scalar parameters
 
 CASES = {
     "periodic_5pt": ["-grid_n", "48,40"],
@@ -23,6 +26,13 @@ CASES = {
     "sources_pins": ["-grid_n", "36,33", "-grid_bc", "neumann", "-source_a", "0.01*sin(x)",
                      "-pin_b", "j < 2"],
     "one_row_blocks": ["-grid_n", "16,4", "-grid_L", "25,6.25"],
+    "periodic_3d_7pt": [DECK_3D, "-grid_n", "14,12,10"],
+    "neumann_3d_19pt": [DECK_3D, "-grid_n", "10,9,8", "-grid_bc", "neumann", "-stencil", "19pt",
+                        "-source_b", "0.01*cos(z)", "-pin_a", "k < 1"],
+    "dirichlet_3d_27pt": [DECK_3D, "-grid_n", "9,10,8", "-grid_bc", "periodic,neumann,dirichlet",
+                          "-dirichlet_a", "4 + 0.1*x", "-stencil", "27pt"],
+    "gray_scott_3d_scalar_params": [GS_DECK, "-grid_n", "8,6,4", "-grid_L", "0.1",
+                                    "-stencil", "7pt"],
 }
 
 
@@ -39,7 +49,8 @@ def test_in_place_equals_second_state_set(tmp_path, case, ranks):
     states = {}
     for mode in ("yes", "no"):
         out = tmp_path / mode
-        p = run([DECK] + CASES[case] + ["-steps", "25", "-snapshot_precision", "float64",
+        args = CASES[case] if CASES[case][0] in (DECK_3D, GS_DECK) else [DECK] + CASES[case]
+        p = run(args + ["-steps", "25", "-snapshot_precision", "float64",
                                         "-summary", "false", "-png_every", "0",
                                         "-explicit_in_place", mode, "-output_dir", str(out)],
                 tmp_path, ranks=ranks)
