@@ -3,6 +3,7 @@
 #include "app/device_types.hpp"
 #include "app/diffusion_setup.hpp"
 #include "app/fft_options.hpp"
+#include "app/float_options.hpp"
 #include "app/model_setup.hpp"
 #include "core/collective_error.hpp"
 #include "core/log_events.hpp"
@@ -43,6 +44,7 @@ Simulation::Simulation(MPI_Comm comm, Options& opt, const std::string& base_dir,
   LogScope log_scope(log_events().setup);
   read_grid(opt, level);
   read_fft_planning(opt);
+  read_float_env(opt);
   read_model(opt, base_dir);
   read_time(opt);
   fluid_ = read_fluid(opt, *grid_, seed_, base_dir);
