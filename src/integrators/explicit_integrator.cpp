@@ -17,7 +17,7 @@ ExplicitIntegrator::ExplicitIntegrator(const Grid& grid, const Halo& halo, RowFn
       floor_(std::move(floor)), params_(params), dirichlet_(dirichlet) {
   to_rows(stencil_, rows_);
   by_class_ = box_classes(rows_, classes_); // 19pt, 27pt: weight classes, rows in class order
-  ring_depth_ = static_cast<int>(reach(1) * grid.owned().m[1]) + reach(0) + 1;
+  ring_depth_ = static_cast<int>(reach(1) * block_rows()) + reach(0) + 1;
   ring_n_ = static_cast<size_t>(grid.owned().m[0]);
   if (params_.any_field())
     params_.expand_scalars(static_cast<size_t>(grid.owned().m[0]), const_rows_);
@@ -227,7 +227,7 @@ bool ExplicitIntegrator::in_place() const {
          bytes >= (grid_.dim() == 3 ? kInPlaceBytes3d : kInPlaceBytes);
 }
 
-// In-place sweeps (header comment): the old row t is last read by row t + R_z ny + R_y.
+// In-place sweeps (header comment): the old row t is last read by row t + R_z bh + R_y.
 int ExplicitIntegrator::reach(int axis) const {
   int r = 0;
   for (int q = 0; q < rows_.nrows; ++q)
@@ -235,13 +235,39 @@ int ExplicitIntegrator::reach(int axis) const {
   return r;
 }
 
-// Copies the new row t (sweep order, owned part) from the ring into u.
-void ExplicitIntegrator::commit_row(const std::vector<PetscScalar*>& u, PetscInt t) const {
+// In 3-D the box is swept in blocks of y rows so that the three z planes a row reads stay in the
+// per-core L2 cache (about 256 KiB of state per block); in 2-D (and for stencils reaching more
+// than one row in y, which the in-place edge rows do not cover) one block is the box.
+PetscInt ExplicitIntegrator::block_rows() const {
   const Box& ob = grid_.owned();
-  const PetscInt dk = t / ob.m[1], dj = t - dk * ob.m[1];
-  for (int s = 0; s < ns_; ++s)
-    std::copy_n(ring_row(s, t), ob.m[0],
-                u[s] + grid_.local_index(ob.s[0], ob.s[1] + dj, ob.s[2] + dk));
+  if (grid_.dim() != 3 || reach(0) > 1) return ob.m[1];
+  const PetscInt bytes_per_row =
+      3 * ns_ * grid_.ghosted().m[0] * static_cast<PetscInt>(sizeof(double));
+  return std::min(ob.m[1], std::max<PetscInt>(4, (256 * 1024) / bytes_per_row - 2));
+}
+
+// Copies the new row t of the block of rows jb .. jb + bh - 1 from the ring into u. Before the
+// block's last row is overwritten, its old values go to edge_[1] (ghosted row, plane k), where
+// the next block reads its row jb - 1.
+void ExplicitIntegrator::commit_row(const std::vector<PetscScalar*>& u, PetscInt t, PetscInt jb,
+                                    PetscInt bh, bool save_edge) const {
+  const Box &ob = grid_.owned(), &gb = grid_.ghosted();
+  const PetscInt k = ob.s[2] + t / bh, j = jb + t % bh;
+  for (int s = 0; s < ns_; ++s) {
+    if (save_edge && j == jb + bh - 1)
+      std::copy_n(u[s] + grid_.local_index(gb.s[0], j, k), gb.m[0], edge_row(1, s, k));
+    std::copy_n(ring_row(s, t), ob.m[0], u[s] + grid_.local_index(ob.s[0], j, k));
+  }
+}
+
+// The old rows jend - 1 of the ghost planes (never overwritten) into edge_[1].
+void ExplicitIntegrator::save_ghost_plane_edges(const std::vector<PetscScalar*>& u,
+                                                PetscInt jend) const {
+  const Box &ob = grid_.owned(), &gb = grid_.ghosted();
+  for (PetscInt k = gb.s[2]; k < gb.s[2] + gb.m[2]; ++k)
+    if (k < ob.s[2] || k >= ob.s[2] + ob.m[2])
+      for (int s = 0; s < ns_; ++s)
+        std::copy_n(u[s] + grid_.local_index(gb.s[0], jend - 1, k), gb.m[0], edge_row(1, s, k));
 }
 
 void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, double dt) const {
@@ -255,7 +281,7 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
   const int nr = rows_.nrows;
   const int np = static_cast<int>(params_.scalar.size());
   const bool field_mode = params_.any_field();
-  const bool in_place = work == nullptr; // 2-D only (in_place())
+  const bool in_place = work == nullptr; // in_place()
   if (in_place) ring_.resize(static_cast<size_t>(ns_) * ring_depth_ * ring_n_);
   std::vector<PetscScalar*> in(ns_), out(ns_);
   std::vector<const PetscScalar*> pf(np, nullptr);
@@ -268,10 +294,12 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
 
   const Box& ob = grid_.owned();
   const PetscInt gx = grid_.ghosted().m[0], gxy = gx * grid_.ghosted().m[1];
-  std::vector<PetscInt> delta(nr);
+  std::vector<PetscInt> delta(nr), dy(nr), dz(nr);
   for (int r = 0; r < nr; ++r) {
     const int q = by_class_ ? classes_.perm[r] : r;
-    delta[r] = gx * rows_.off[q][0] + gxy * rows_.off[q][1];
+    dy[r] = rows_.off[q][0];
+    dz[r] = rows_.off[q][1];
+    delta[r] = gx * dy[r] + gxy * dz[r];
   }
   std::vector<const double*> src(static_cast<size_t>(ns_ * nr));
   std::vector<double*> dst(ns_);
@@ -287,30 +315,30 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
   row.dt = dt;
   row.dst = dst.data();
   row.wclass = by_class_ ? classes_.w.data() : nullptr;
-  // In 3-D, sweep the box in blocks of y rows so that the three z planes a row reads stay in
-  // the per-core L2 cache (about 256 KiB of state per block); in 2-D and in place (whose ring
-  // needs the plain order t = (k - k0) ny + j - j0) one block is the box.
-  PetscInt jblock = ob.m[1];
-  const PetscInt lag = ring_depth_ - 1;
-  if (grid_.dim() == 3 && !in_place) {
-    const PetscInt bytes_per_row = 3 * ns_ * gx * static_cast<PetscInt>(sizeof(double));
-    jblock = std::max<PetscInt>(4, (256 * 1024) / bytes_per_row - 2);
-  }
+  const PetscInt jblock = block_rows(), jlast = ob.s[1] + ob.m[1];
+  const int ry = reach(0), rz = reach(1);
+  if (in_place && jblock < ob.m[1])
+    for (auto& e : edge_)
+      e.resize(static_cast<size_t>(ns_ * grid_.ghosted().m[2] * gx));
   // With scalar parameters into a second state set (no ring), one call sweeps all rows of a
   // block (the kernel steps the row pointers by the ghosted row length): small grids spend less
   // on per-call setup. Same arithmetic per cell either way.
   const bool multi = !in_place && !field_mode && !by_class_;
   row.src_stride = row.dst_stride = gx;
-  for (PetscInt jb = ob.s[1]; jb < ob.s[1] + ob.m[1]; jb += jblock) {
-    const PetscInt jend = std::min(jb + jblock, ob.s[1] + ob.m[1]);
+  for (PetscInt jb = ob.s[1]; jb < jlast; jb += jblock) {
+    const PetscInt jend = std::min(jb + jblock, jlast), bh = jend - jb, lag = rz * bh + ry;
+    const bool from_edge = in_place && jb > ob.s[1], to_edge = in_place && jend < jlast;
+    if (to_edge) save_ghost_plane_edges(in, jend);
     for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
       for (PetscInt j = jb; j < jend; j += row.rows) {
         row.rows = multi ? static_cast<int>(jend - j) : 1;
         const PetscInt c = grid_.local_index(ob.s[0], j, k);
-        const PetscInt t = row_order(j, k);
+        const PetscInt t = (k - ob.s[2]) * bh + (j - jb); // order within the block
         for (int s = 0; s < ns_; ++s) {
           for (int r = 0; r < nr; ++r)
-            src[s * nr + r] = in[s] + c + delta[r];
+            src[s * nr + r] = from_edge && j == jb && dy[r] < 0
+                                  ? edge_row(0, s, k + dz[r]) + (ob.s[0] - grid_.ghosted().s[0])
+                                  : in[s] + c + delta[r];
           dst[s] = in_place ? ring_row(s, t) : out[s] + c;
         }
         if (field_mode) {
@@ -319,13 +347,13 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
             prow[q] = pf[q] ? pf[q] + o : const_rows_[q].data();
         }
         row_fn_(row);
-        if (in_place && t >= lag) commit_row(in, t - lag);
+        if (in_place && t >= lag) commit_row(in, t - lag, jb, bh, to_edge);
       }
-  }
-  if (in_place) {
-    const PetscInt tend = ob.m[1] * ob.m[2];
+    if (!in_place) continue;
+    const PetscInt tend = bh * ob.m[2];
     for (PetscInt t = std::max<PetscInt>(0, tend - lag); t < tend; ++t)
-      commit_row(in, t);
+      commit_row(in, t, jb, bh, to_edge);
+    std::swap(edge_[0], edge_[1]);
   }
 
   for (int q = 0; q < np; ++q)

@@ -5,11 +5,14 @@
 // The driver owns communication: halo update of every species (begin all, end all, then the
 // physical boundaries), then one pass over the owned box calling the model's fused row kernel
 // (explicit_kernel.hpp) for each grid row. State lives in ghosted local Vecs. The fast path
-// updates them in place where a rank's state is large (set_in_place): rows are swept in the order
-// t = k ny + j, and the old row t is last read by row t + R_z ny + R_y (R: the stencil's reach in
-// y and z), so each new row waits in a ring of R_z ny + R_y + 1 row buffers (2-D: R_y + 1 rows,
-// 3-D: about one plane) until the rows reading it are done. There is no second state set (8 bytes
-// per cell and species less) and the sweep moves 16 bytes per cell and species (no write-allocate
+// updates them in place where a rank's state is large (set_in_place). In 3-D the box is swept in
+// blocks of bh y rows (all planes of a block, then the next block: L2 reuse of the three planes
+// a row reads), in 2-D as one block; within a block rows go in the order t = (k - k0) bh + j - jb,
+// and the old row t is last read by row t + R_z bh + R_y (R: the stencil's reach in y and z), so
+// each new row waits in a ring of R_z bh + R_y + 1 row buffers (2-D: R_y + 1 rows) until the rows
+// reading it are done; the old values of a block's last row are kept (one row per plane) for the
+// next block, which reads them as its row jb - 1. There is no second state set (8 bytes per cell
+// and species less) and the sweep moves 16 bytes per cell and species (no write-allocate
 // of a second array). Otherwise (small states, the general path, fused steps) the new state is
 // written into a second set, and the two are swapped (no global-to-local
 // copy). The step is stable for dt <= 2 / (D_max * spectral_radius(L)) (the diffusion bound, dt <=
@@ -98,19 +101,22 @@ private:
   // work == nullptr: in place (in_place()).
   void sweep(std::vector<VecH>& u, std::vector<VecH>* work, double dt) const;
   bool in_place() const;
-  int reach(int axis) const; // the stencil's reach in y (axis 0) or z (axis 1)
-  // Row (j, k) in sweep order: t = (k - k0) ny + (j - j0) (owned rows j0 .. j0 + ny - 1 of
-  // planes k0 ..); the ring slot is t mod its depth.
-  PetscInt row_order(PetscInt j, PetscInt k) const {
-    const Box& ob = grid_.owned();
-    return (k - ob.s[2]) * ob.m[1] + (j - ob.s[1]);
-  }
+  int reach(int axis) const;   // the stencil's reach in y (axis 0) or z (axis 1)
+  PetscInt block_rows() const; // y rows per block of the sweep
+  // Ring slot of row t of a block (order within the block: t = (k - k0) bh + j - jb).
   double* ring_row(int s, PetscInt t) const {
     return ring_.data() + (static_cast<size_t>(s) * ring_depth_ +
                            static_cast<size_t>(t) % static_cast<size_t>(ring_depth_)) *
                               ring_n_;
   }
-  void commit_row(const std::vector<PetscScalar*>& u, PetscInt t) const;
+  // Old ghosted row just outside a block, plane k (b = 0: above this block, 1: for the next).
+  double* edge_row(int b, int s, PetscInt k) const {
+    const Box& gb = grid_.ghosted();
+    return edge_[b].data() + (static_cast<size_t>(s) * gb.m[2] + (k - gb.s[2])) * gb.m[0];
+  }
+  void commit_row(const std::vector<PetscScalar*>& u, PetscInt t, PetscInt jb, PetscInt bh,
+                  bool save_edge) const;
+  void save_ghost_plane_edges(const std::vector<PetscScalar*>& u, PetscInt jend) const;
   void add_other_terms(std::vector<VecH>& u, double t, double dt);
   void step_general(std::vector<VecH>& u, std::vector<VecH>& work, double dt) const;
 
@@ -130,12 +136,13 @@ private:
   PreFn pre_fn_;
   mutable std::vector<std::vector<double>> div_; // per species row buffer of the general path
   const TermList* terms_ = nullptr;
-  std::vector<const Term*> others_;    // terms evaluated through add_rates
-  bool constrain_after_sweep_ = false; // constraints other than the kernel's clamp floor
-  std::vector<VecH> work_;             // second state set (created when first needed)
-  mutable std::vector<double> ring_;   // in-place sweeps: [ns][depth][nx] new rows
-  int ring_depth_ = 2;                 // R_z ny + R_y + 1
-  size_t ring_n_ = 0;                  // owned cells per row
+  std::vector<const Term*> others_;     // terms evaluated through add_rates
+  bool constrain_after_sweep_ = false;  // constraints other than the kernel's clamp floor
+  std::vector<VecH> work_;              // second state set (created when first needed)
+  mutable std::vector<double> ring_;    // in-place sweeps: [ns][depth][nx] new rows
+  int ring_depth_ = 2;                  // R_z bh + R_y + 1 (bh: block_rows())
+  mutable std::vector<double> edge_[2]; // in-place 3-D blocks: [ns][ghosted z][ghosted x]
+  size_t ring_n_ = 0;                   // owned cells per row
   InPlace in_place_ = InPlace::Auto;
   std::vector<std::vector<double>> rates_; // owned layout, per species (other terms)
   int fuse_request_ = 1;

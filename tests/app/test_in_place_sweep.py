@@ -3,7 +3,8 @@ explicit_integrator.hpp: new rows wait in a ring of row buffers until the rows r
 done) gives the same bytes as the sweep into a second state set, on 1, 2 and 4 ranks: 5-point
 and 9-point stencils in 2-D, 7-, 19- and 27-point stencils in 3-D (where the ring is about a
 plane), periodic, zero-flux and Dirichlet boundaries, per-cell and scalar parameters, sources,
-pinned cells, and grids whose rank blocks are a single row. `auto` chooses in place only
+pinned cells, grids whose rank blocks are a single row, and 3-D grids swept in several blocks
+of y rows. `auto` chooses in place only
 where a rank's state is at least 8 MiB, 64 MiB in 3-D (the run's memory matters; in cache the
 row copies cost more than the write-allocate they save)."""
 import os
@@ -33,6 +34,15 @@ CASES = {
                           "-dirichlet_a", "4 + 0.1*x", "-stencil", "27pt"],
     "gray_scott_3d_scalar_params": [GS_DECK, "-grid_n", "8,6,4", "-grid_L", "0.1",
                                     "-stencil", "7pt"],
+    # Rows of 600-1000 cells: the 3-D sweep goes in blocks of 4-19 y rows (block_rows(), about
+    # 256 KiB of three planes), each block reading the saved old row above it; the last block
+    # is partial.
+    "blocks_3d_7pt": [DECK_3D, "-grid_n", "1000,26,6"],
+    "blocks_3d_27pt_dirichlet": [DECK_3D, "-grid_n", "600,23,5", "-stencil", "27pt",
+                                 "-grid_bc", "periodic,dirichlet,neumann",
+                                 "-dirichlet_b", "4 - 0.1*y"],
+    "blocks_3d_19pt_scalar_params": [GS_DECK, "-grid_n", "800,22,5", "-grid_L", "8,0.22,0.05",
+                                     "-stencil", "19pt"],
 }
 
 
