@@ -1,8 +1,8 @@
 """The explicit fast path's in-place update (-explicit_in_place; integrators/
 explicit_integrator.hpp: new rows wait in a ring of row buffers until the rows reading them are
 done) gives the same bytes as the sweep into a second state set, on 1, 2 and 4 ranks: 5-point
-and 9-point stencils in 2-D, 7-, 19- and 27-point stencils in 3-D (where the ring is about a
-plane), periodic, zero-flux and Dirichlet boundaries, per-cell and scalar parameters, sources,
+and 9-point stencils in 2-D, 7-, 19- and 27-point stencils in 3-D (swept in blocks of y rows,
+each reading the saved old row above it), periodic, zero-flux and Dirichlet boundaries, per-cell and scalar parameters, sources,
 pinned cells, grids whose rank blocks are a single row, and 3-D grids swept in several blocks
 of y rows. `auto` chooses in place only
 where a rank's state is at least 8 MiB, 64 MiB in 3-D (the run's memory matters; in cache the
