@@ -1,11 +1,14 @@
 #include "grid/spectral_transform.hpp"
 
+#include "core/user_error.hpp"
 #include "grid/fft_planning.hpp"
 
 #include <algorithm>
+#include <climits>
 #include <fftw3.h>
 #include <petscao.h>
 #include <petscdmda.h>
+#include <string>
 
 namespace morphogen {
 
@@ -54,10 +57,9 @@ SpectralTransform::SpectralTransform(const Grid& grid, const std::array<AxisKind
   S_ = g.n[dim - 1];
   ncols_ = grid.global_cells() / S_;
   ncolsS_ = all_periodic ? ncols_ / g.n[0] * (g.n[0] / 2 + 1) : ncols_;
-  a0_ = part(S_, size_, rank);
-  a1_ = part(S_, size_, rank + 1);
-  b0_ = size_ == 1 ? 0 : part(ncolsS_, size_, rank);
-  nb_ = size_ == 1 ? ncolsS_ : part(ncolsS_, size_, rank + 1) - b0_;
+  comm_ = grid.comm();
+  rank_ = rank;
+  slab_ranges(grid);
   const size_t nA = static_cast<size_t>(a1_ - a0_);
   realA_ = fftw_alloc_real(std::max<size_t>(1, nA * ncols_));
   specA_ = fftw_alloc_real(std::max<size_t>(1, nA * ncolsS_ * w_));
@@ -68,14 +70,100 @@ SpectralTransform::SpectralTransform(const Grid& grid, const std::array<AxisKind
     plans_ = std::make_unique<Plans>();
     plan(grid, kinds);
   }
-  if (size_ > 1) make_scatters(grid);
+  if (!direct_) make_scatter(grid);
+  if (size_ > 1) transpose_counts();
+}
+
+// Layout A's planes: the DMDA's own slow-axis ranges when every rank owns whole planes (layout
+// A is then the DMDA vector), an even split otherwise. Spectral columns: an even split.
+void SpectralTransform::slab_ranges(const Grid& grid) {
+  const int dim = grid.dim();
+  const Box& ob = grid.owned();
+  int whole = 1;
+  for (int d = 0; d < dim - 1; ++d)
+    whole &= ob.s[d] == 0 && ob.m[d] == grid.spec().n[d] ? 1 : 0;
+  MPI_Allreduce(MPI_IN_PLACE, &whole, 1, MPI_INT, MPI_LAND, comm_);
+  direct_ = whole != 0;
+  aparts_.assign(static_cast<size_t>(size_) + 1, S_);
+  bparts_.assign(static_cast<size_t>(size_) + 1, ncolsS_);
+  if (direct_) {
+    PetscInt first = ob.s[dim - 1];
+    MPI_Allgather(&first, 1, MPIU_INT, aparts_.data(), 1, MPIU_INT, comm_);
+  }
+  for (int r = 0; r < size_; ++r) {
+    if (!direct_) aparts_[static_cast<size_t>(r)] = part(S_, size_, r);
+    bparts_[static_cast<size_t>(r)] = part(ncolsS_, size_, r);
+  }
+  a0_ = aparts_[static_cast<size_t>(rank_)];
+  a1_ = aparts_[static_cast<size_t>(rank_) + 1];
+  b0_ = bparts_[static_cast<size_t>(rank_)];
+  nb_ = bparts_[static_cast<size_t>(rank_) + 1] - b0_;
+}
+
+// Counts and displacements (doubles) of the transposes: the packed block of this rank's planes
+// for rank q (pack: A -> B sends these, B -> A receives them) and the rows of B that rank p's
+// planes fill (rows: A -> B receives, B -> A sends). This rank's own block is copied directly.
+void SpectralTransform::transpose_counts() {
+  const long long w = w_, nA = a1_ - a0_;
+  scount_.assign(static_cast<size_t>(size_), 0);
+  sdispl_ = rcount_ = rdispl_ = scount_;
+  long long off = 0;
+  for (int q = 0; q < size_; ++q) {
+    const size_t uq = static_cast<size_t>(q);
+    const long long pack = q == rank_ ? 0 : nA * (bparts_[uq + 1] - bparts_[uq]) * w;
+    const long long rows = q == rank_ ? 0 : (aparts_[uq + 1] - aparts_[uq]) * nb_ * w;
+    if (off + pack > INT_MAX || aparts_[uq + 1] * nb_ * w > INT_MAX)
+      throw UserError("spectral solve: more than 2^31 spectral values on one rank (grid " +
+                      std::to_string(S_) + " planes); use more ranks or -diffusion_solver ksp");
+    scount_[uq] = static_cast<int>(pack);
+    sdispl_[uq] = static_cast<int>(off);
+    rcount_[uq] = static_cast<int>(rows);
+    rdispl_[uq] = static_cast<int>(aparts_[uq] * nb_ * w);
+    off += pack;
+  }
+  xbuf_.resize(static_cast<size_t>(std::max(1LL, off)));
+}
+
+// Copies between this rank's planes of layout A and the blocks of the transposes: the block
+// of columns of rank q goes to (to_b) or comes from its packed place in xbuf, this rank's own
+// block to or from its rows of B directly.
+void SpectralTransform::copy_blocks(bool to_b) {
+  const size_t w = static_cast<size_t>(w_), nA = static_cast<size_t>(a1_ - a0_);
+  const size_t rowA = static_cast<size_t>(ncolsS_) * w, rowB = static_cast<size_t>(nb_) * w;
+  for (int q = 0; q < size_; ++q) {
+    const size_t uq = static_cast<size_t>(q);
+    const size_t c0 = static_cast<size_t>(bparts_[uq]) * w;
+    const size_t len = static_cast<size_t>(bparts_[uq + 1] - bparts_[uq]) * w;
+    for (size_t s = 0; s < nA; ++s) {
+      double* a = specA_ + s * rowA + c0;
+      double* o = q == rank_ ? specB_ + (static_cast<size_t>(a0_) + s) * rowB
+                             : xbuf_.data() + static_cast<size_t>(sdispl_[uq]) + s * len;
+      if (to_b)
+        std::copy(a, a + len, o);
+      else
+        std::copy(o, o + len, a);
+    }
+  }
+}
+
+// A -> B: the blocks packed by destination, one MPI_Alltoallv whose blocks land as rows of B.
+void SpectralTransform::to_columns() {
+  copy_blocks(true);
+  MPI_Alltoallv(xbuf_.data(), scount_.data(), sdispl_.data(), MPI_DOUBLE, specB_, rcount_.data(),
+                rdispl_.data(), MPI_DOUBLE, comm_);
+}
+
+// B -> A: one MPI_Alltoallv of whole rows of B, then each block unpacked into its columns.
+void SpectralTransform::from_columns() {
+  MPI_Alltoallv(specB_, rcount_.data(), rdispl_.data(), MPI_DOUBLE, xbuf_.data(), scount_.data(),
+                sdispl_.data(), MPI_DOUBLE, comm_);
+  copy_blocks(false);
 }
 
 SpectralTransform::~SpectralTransform() {
   plans_.reset();
+  toA_.reset();
   vA_.reset();
-  vSA_.reset();
-  vSB_.reset();
   if (specB_ != specA_) fftw_free(specB_);
   fftw_free(specA_);
   fftw_free(realA_);
@@ -125,8 +213,8 @@ void SpectralTransform::plan(const Grid& grid, const std::array<AxisKind, 3>& ki
   }
 }
 
-// DMDA (PETSc order) -> layout A (natural order, slabs); layout A -> B (column slabs).
-void SpectralTransform::make_scatters(const Grid& grid) {
+// DMDA (PETSc order) -> layout A (natural order, slabs), for a DMDA not split in slabs.
+void SpectralTransform::make_scatter(const Grid& grid) {
   MPI_Comm comm = grid.comm();
   const PetscInt nA = (a1_ - a0_) * ncols_;
   MG_PETSC(VecCreateMPIWithArray(comm, 1, nA, PETSC_DECIDE, realA_, vA_.out()));
@@ -136,67 +224,68 @@ void SpectralTransform::make_scatters(const Grid& grid) {
   AO ao;
   MG_PETSC(DMDAGetAO(grid.dm(), &ao));
   MG_PETSC(AOApplicationToPetsc(ao, nA, idx.data()));
-  {
-    IS from, to;
-    MG_PETSC(ISCreateGeneral(comm, nA, idx.data(), PETSC_COPY_VALUES, &from));
-    MG_PETSC(ISCreateStride(comm, nA, a0_ * ncols_, 1, &to));
-    VecH u = grid.create_global();
-    MG_PETSC(VecScatterCreate(u, from, vA_, to, toA_.out()));
-    MG_PETSC(ISDestroy(&from));
-    MG_PETSC(ISDestroy(&to));
-  }
-  const PetscInt nSA = (a1_ - a0_) * ncolsS_, nSB = S_ * nb_;
-  MG_PETSC(VecCreateMPIWithArray(comm, w_, nSA * w_, PETSC_DECIDE, specA_, vSA_.out()));
-  MG_PETSC(VecCreateMPIWithArray(comm, w_, nSB * w_, PETSC_DECIDE, specB_, vSB_.out()));
-  std::vector<PetscInt> from_b(static_cast<size_t>(nSB)), to_b(static_cast<size_t>(nSB));
-  size_t e = 0;
-  for (PetscInt s = 0; s < S_; ++s)
-    for (PetscInt c = b0_; c < b0_ + nb_; ++c, ++e) {
-      from_b[e] = s * ncolsS_ + c;
-      to_b[e] = S_ * b0_ + s * nb_ + (c - b0_);
-    }
   IS from, to;
-  MG_PETSC(ISCreateBlock(comm, w_, nSB, from_b.data(), PETSC_COPY_VALUES, &from));
-  MG_PETSC(ISCreateBlock(comm, w_, nSB, to_b.data(), PETSC_COPY_VALUES, &to));
-  MG_PETSC(VecScatterCreate(vSA_, from, vSB_, to, toB_.out()));
+  MG_PETSC(ISCreateGeneral(comm, nA, idx.data(), PETSC_COPY_VALUES, &from));
+  MG_PETSC(ISCreateStride(comm, nA, a0_ * ncols_, 1, &to));
+  VecH u = grid.create_global();
+  MG_PETSC(VecScatterCreate(u, from, vA_, to, toA_.out()));
   MG_PETSC(ISDestroy(&from));
   MG_PETSC(ISDestroy(&to));
 }
 
-void SpectralTransform::forward(Vec u) {
-  if (size_ == 1) {
-    const PetscScalar* a;
-    MG_PETSC(VecGetArrayRead(u, &a));
-    std::copy(a, a + S_ * ncols_, realA_);
-    MG_PETSC(VecRestoreArrayRead(u, &a));
-  } else {
+// T_rest from the DMDA vector u into specA (directly from u's array when layout A is u's part
+// and FFTW's alignment of the two arrays agrees, else through realA).
+void SpectralTransform::rest_forward(Vec u) {
+  const PetscScalar* a = nullptr;
+  double* in = realA_;
+  if (!direct_) {
     MG_PETSC(VecScatterBegin(toA_, u, vA_, INSERT_VALUES, SCATTER_FORWARD));
     MG_PETSC(VecScatterEnd(toA_, u, vA_, INSERT_VALUES, SCATTER_FORWARD));
+  } else {
+    MG_PETSC(VecGetArrayRead(u, &a));
+    if (fftw_alignment_of(const_cast<double*>(a)) == fftw_alignment_of(realA_))
+      in = const_cast<double*>(a); // FFTW's forward out-of-place plans preserve their input
+    else
+      std::copy(a, a + (a1_ - a0_) * ncols_, realA_);
   }
-  run(plans_->restF);
-  if (size_ > 1) {
-    MG_PETSC(VecScatterBegin(toB_, vSA_, vSB_, INSERT_VALUES, SCATTER_FORWARD));
-    MG_PETSC(VecScatterEnd(toB_, vSA_, vSB_, INSERT_VALUES, SCATTER_FORWARD));
-  }
-  run(plans_->slowF);
+  if (plans_->restF && w_ == 2)
+    fftw_execute_dft_r2c(plans_->restF, in, reinterpret_cast<fftw_complex*>(specA_));
+  else if (plans_->restF)
+    fftw_execute_r2r(plans_->restF, in, specA_);
+  if (a) MG_PETSC(VecRestoreArrayRead(u, &a));
 }
 
-void SpectralTransform::backward(Vec u) {
-  run(plans_->slowB);
-  if (size_ > 1) {
-    MG_PETSC(VecScatterBegin(toB_, vSB_, vSA_, INSERT_VALUES, SCATTER_REVERSE));
-    MG_PETSC(VecScatterEnd(toB_, vSB_, vSA_, INSERT_VALUES, SCATTER_REVERSE));
-  }
-  run(plans_->restB);
-  if (size_ == 1) {
-    PetscScalar* a;
+// T_rest^-1 from specA (destroyed) into the DMDA vector u.
+void SpectralTransform::rest_backward(Vec u) {
+  PetscScalar* a = nullptr;
+  double* out = realA_;
+  if (direct_) {
     MG_PETSC(VecGetArray(u, &a));
-    std::copy(realA_, realA_ + S_ * ncols_, a);
+    if (fftw_alignment_of(a) == fftw_alignment_of(realA_)) out = a;
+  }
+  if (plans_->restB && w_ == 2)
+    fftw_execute_dft_c2r(plans_->restB, reinterpret_cast<fftw_complex*>(specA_), out);
+  else if (plans_->restB)
+    fftw_execute_r2r(plans_->restB, specA_, out);
+  if (a) {
+    if (out != a) std::copy(realA_, realA_ + (a1_ - a0_) * ncols_, a);
     MG_PETSC(VecRestoreArray(u, &a));
   } else {
     MG_PETSC(VecScatterBegin(toA_, vA_, u, INSERT_VALUES, SCATTER_REVERSE));
     MG_PETSC(VecScatterEnd(toA_, vA_, u, INSERT_VALUES, SCATTER_REVERSE));
   }
+}
+
+void SpectralTransform::forward(Vec u) {
+  rest_forward(u);
+  if (size_ > 1) to_columns();
+  run(plans_->slowF);
+}
+
+void SpectralTransform::backward(Vec u) {
+  run(plans_->slowB);
+  if (size_ > 1) from_columns();
+  rest_backward(u);
 }
 
 } // namespace morphogen

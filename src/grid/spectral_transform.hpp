@@ -8,10 +8,14 @@
 // Otherwise real r2r kinds: R2HC on periodic axes, REDFT10 on even and RODFT10 on odd axes
 // (backward HC2R, REDFT01, RODFT01). FFTW is unnormalised: backward(forward(u)) = norm() u.
 //
-// Parallel layout (slabs, two transposes by PetscSF scatters): layout A gives each rank a
-// contiguous range of slow-axis planes, where T_rest runs; layout B gives each rank a range of
-// spectral columns (all slow-axis entries of them), where T_slow runs and where the spectrum
-// lives. Useful up to min(slow cells, spectral columns) ranks; on one rank nothing is scattered.
+// Parallel layout (slabs): layout A gives each rank a contiguous range of slow-axis planes,
+// where T_rest runs; layout B gives each rank a range of spectral columns (all slow-axis
+// entries of them), where T_slow runs and where the spectrum lives. A -> B and back are one
+// MPI_Alltoallv each (the block for rank q packed from this rank's planes; the block from rank
+// p lands as p's rows of B with no unpacking; this rank's own block is copied directly). When
+// the DMDA is split along the slow axis only (1 x 1 x P or 1 x P), layout A takes its ranges
+// and T_rest reads and writes the DMDA vector itself; otherwise a PetscSF scatter moves the
+// field between the DMDA and layout A. Useful up to min(slow cells, spectral columns) ranks.
 // Plans: grid/fft_planning.hpp (FFTW_MEASURE by default, kept in a wisdom file so that later
 // runs re-create the same plans and the same arithmetic).
 #pragma once
@@ -46,16 +50,28 @@ public:
 
 private:
   void plan(const Grid& grid, const std::array<AxisKind, 3>& kinds);
-  void make_scatters(const Grid& grid);
+  void make_scatter(const Grid& grid);
+  void slab_ranges(const Grid& grid);
+  void transpose_counts();
+  void copy_blocks(bool to_b);
+  void to_columns();   // layout A -> B
+  void from_columns(); // layout B -> A
+  void rest_forward(Vec u);
+  void rest_backward(Vec u);
   PetscInt S_ = 1, ncols_ = 1, ncolsS_ = 1;    // slow-axis cells, rest cells, rest spectral columns
   PetscInt a0_ = 0, a1_ = 0, b0_ = 0, nb_ = 0; // my slow planes [a0, a1), columns [b0, b0 + nb)
-  int w_ = 1, size_ = 1;
+  int w_ = 1, size_ = 1, rank_ = 0;
+  bool direct_ = true; // layout A is this rank's part of the DMDA vector
+  MPI_Comm comm_ = MPI_COMM_NULL;
+  std::vector<PetscInt> aparts_, bparts_; // [size + 1]: first plane / column of each rank
+  std::vector<int> scount_, sdispl_, rcount_, rdispl_;
+  std::vector<double> xbuf_; // packed blocks of the transposes
   double norm_ = 1.0;
   double *realA_ = nullptr, *specA_ = nullptr, *specB_ = nullptr;
   struct Plans;
   std::unique_ptr<Plans> plans_;
-  VecH vA_, vSA_, vSB_;
-  SFH toA_, toB_; // DMDA -> layout A (reals), layout A -> B (spectral entries)
+  VecH vA_;
+  SFH toA_; // DMDA -> layout A (reals), when not direct_
 };
 
 } // namespace morphogen
