@@ -41,15 +41,16 @@ std::array<AxisKind, 3> axis_kinds(const Grid& grid) {
   return k;
 }
 
-SpectralTransform::SpectralTransform(const Grid& grid, const std::array<AxisKind, 3>& kinds)
-    : plans_(std::make_unique<Plans>()) {
+SpectralTransform::SpectralTransform(const Grid& grid, const std::array<AxisKind, 3>& kinds,
+                                     bool rest_only)
+    : rest_only_(rest_only), plans_(std::make_unique<Plans>()) {
   int rank = 0;
   MPI_Comm_size(grid.comm(), &size_);
   MPI_Comm_rank(grid.comm(), &rank);
   const GridSpec& g = grid.spec();
   const int dim = grid.dim();
   bool all_periodic = true;
-  for (int d = 0; d < dim; ++d) {
+  for (int d = 0; d < (rest_only ? dim - 1 : dim); ++d) {
     all_periodic &= kinds[d] == AxisKind::Periodic;
     norm_ *= static_cast<double>(kinds[d] == AxisKind::Periodic ? g.n[d] : 2 * g.n[d]);
   }
@@ -63,7 +64,7 @@ SpectralTransform::SpectralTransform(const Grid& grid, const std::array<AxisKind
   const size_t nA = static_cast<size_t>(a1_ - a0_);
   realA_ = fftw_alloc_real(std::max<size_t>(1, nA * ncols_));
   specA_ = fftw_alloc_real(std::max<size_t>(1, nA * ncolsS_ * w_));
-  specB_ = size_ == 1 ? specA_ : fftw_alloc_real(std::max<size_t>(1, entries() * w_));
+  specB_ = size_ == 1 || rest_only_ ? specA_ : fftw_alloc_real(std::max<size_t>(1, entries() * w_));
   fft_wisdom_load();
   plan(grid, kinds);
   if (fft_wisdom_sync(grid.comm())) { // again, from the wisdom every rank now shares
@@ -71,7 +72,7 @@ SpectralTransform::SpectralTransform(const Grid& grid, const std::array<AxisKind
     plan(grid, kinds);
   }
   if (!direct_) make_scatter(grid);
-  if (size_ > 1) transpose_counts();
+  if (size_ > 1 && !rest_only_) transpose_counts();
 }
 
 // Layout A's planes: the DMDA's own slow-axis ranges when every rank owns whole planes (layout
@@ -199,6 +200,7 @@ void SpectralTransform::plan(const Grid& grid, const std::array<AxisKind, 3>& ki
     p.restB = fftw_plan_many_r2r(nrest, rest, howA, specA_, nullptr, 1, nc, realA_, nullptr, 1, nc,
                                  kb + 1, flags);
   }
+  if (rest_only_) return;
   if (nb > 0 && w_ == 2) {
     auto* cB = reinterpret_cast<fftw_complex*>(specB_);
     p.slowF =
@@ -278,13 +280,13 @@ void SpectralTransform::rest_backward(Vec u) {
 
 void SpectralTransform::forward(Vec u) {
   rest_forward(u);
-  if (size_ > 1) to_columns();
+  if (size_ > 1 && !rest_only_) to_columns();
   run(plans_->slowF);
 }
 
 void SpectralTransform::backward(Vec u) {
   run(plans_->slowB);
-  if (size_ > 1) from_columns();
+  if (size_ > 1 && !rest_only_) from_columns();
   rest_backward(u);
 }
 

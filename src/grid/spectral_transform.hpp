@@ -16,6 +16,9 @@
 // the DMDA is split along the slow axis only (1 x 1 x P or 1 x P), layout A takes its ranges
 // and T_rest reads and writes the DMDA vector itself; otherwise a PetscSF scatter moves the
 // field between the DMDA and layout A. Useful up to min(slow cells, spectral columns) ranks.
+// rest_only: T_rest alone (no slow-axis transform, no transposes): the spectrum is layout A,
+// planes() planes from first_plane() of columns() entries each, rest axes' normalisation; the
+// DFT is complex (r2c) when every rest axis is periodic (operators/tridiagonal_solver.hpp).
 // Plans: grid/fft_planning.hpp (FFTW_MEASURE by default, kept in a wisdom file so that later
 // runs re-create the same plans and the same arithmetic).
 #pragma once
@@ -35,7 +38,7 @@ std::array<AxisKind, 3> axis_kinds(const Grid& grid);
 
 class SpectralTransform {
 public:
-  SpectralTransform(const Grid& grid, const std::array<AxisKind, 3>& kinds);
+  SpectralTransform(const Grid& grid, const std::array<AxisKind, 3>& kinds, bool rest_only = false);
   ~SpectralTransform();
   SpectralTransform(const SpectralTransform&) = delete;
   SpectralTransform& operator=(const SpectralTransform&) = delete;
@@ -44,7 +47,15 @@ public:
   void backward(Vec u); // u = T^-1 spectrum() * norm() (destroys the spectrum)
   double* spectrum() { return specB_; }
   // This rank's spectral entries, each width() doubles (2: complex, 1: real).
-  size_t entries() const { return static_cast<size_t>(S_) * static_cast<size_t>(nb_); }
+  size_t entries() const {
+    return rest_only_ ? static_cast<size_t>(a1_ - a0_) * static_cast<size_t>(ncolsS_)
+                      : static_cast<size_t>(S_) * static_cast<size_t>(nb_);
+  }
+  // Layout A (the spectrum of a rest_only transform): this rank's planes, spectral columns.
+  PetscInt first_plane() const { return a0_; }
+  PetscInt planes() const { return a1_ - a0_; }
+  PetscInt columns() const { return ncolsS_; }
+  PetscInt slow_cells() const { return S_; }
   int width() const { return w_; }
   double norm() const { return norm_; }
 
@@ -61,6 +72,7 @@ private:
   PetscInt S_ = 1, ncols_ = 1, ncolsS_ = 1;    // slow-axis cells, rest cells, rest spectral columns
   PetscInt a0_ = 0, a1_ = 0, b0_ = 0, nb_ = 0; // my slow planes [a0, a1), columns [b0, b0 + nb)
   int w_ = 1, size_ = 1, rank_ = 0;
+  bool rest_only_ = false;
   bool direct_ = true; // layout A is this rank's part of the DMDA vector
   MPI_Comm comm_ = MPI_COMM_NULL;
   std::vector<PetscInt> aparts_, bparts_; // [size + 1]: first plane / column of each rank

@@ -40,10 +40,28 @@ DiffusionSolver::DiffusionSolver(const Grid& grid, const OperatorMatrices& ops,
                  "diffusion substep solver: spectral (exact FFT/DCT solve; periodic "
                  "or zero-flux axes, constant coefficients), ksp, or auto (spectral where it "
                  "applies and no -diffusion_ksp_*/-diffusion_pc_* option is given)"),
+      opt.choice("diffusion_slow_axis", "auto", {"auto", "fft", "tridiagonal"},
+                 "the spectral solve along the slowest axis (y in 2-D, z in 3-D): tridiagonal "
+                 "(elimination after the transform of the other axes: no FFT along it and no "
+                 "transposes between the ranks; up to 64 ranks, no cross terms with it), fft "
+                 "(the full transform), or auto (tridiagonal where it applies, else fft)"),
       varying);
 }
 
-void DiffusionSolver::choose_spectral(const std::string& mode,
+// The exact solve of species s: tridiagonal along the slowest axis (slow: auto, tridiagonal) or
+// the full transform (auto where the tridiagonal one does not apply, fft); null and *why if none.
+std::unique_ptr<ExactSolve> DiffusionSolver::exact_for(int s, const std::string& slow,
+                                                       std::string* why) {
+  std::string why_tri;
+  if (slow != "fft")
+    if (auto t = TridiagonalSolver::create(grid_, ops_.M(s), &why_tri)) return t;
+  if (slow == "tridiagonal")
+    throw UserError("-diffusion_slow_axis tridiagonal: species " + species_[s] + ": " + why_tri +
+                    "; allowed here: auto or fft");
+  return SpectralSolver::create(grid_, ops_.M(s), why);
+}
+
+void DiffusionSolver::choose_spectral(const std::string& mode, const std::string& slow,
                                       const std::vector<std::string>& varying) {
   const int ns = ops_.nspecies();
   spectral_.resize(ns);
@@ -72,13 +90,13 @@ void DiffusionSolver::choose_spectral(const std::string& mode,
     else if (!ops_.symmetric(s))
       why = "a non-symmetric operator";
     else
-      spectral_[s] = SpectralSolver::create(grid_, ops_.M(s), &why);
+      spectral_[s] = exact_for(s, slow, &why);
     if (!spectral_[s] && mode == "spectral")
       throw UserError("-diffusion_solver spectral: species " + species_[s] + ": " + why +
                       "; allowed here: ksp or auto");
     if (spectral_[s]) spectral_mat_[s] = ops_.M(s);
     PetscPrintf(grid_.comm(), "  diffusion solve of %s: %s\n", species_[s].c_str(),
-                spectral_[s] ? "spectral (FFT/DCT, exact)" : ("ksp (" + why + ")").c_str());
+                (spectral_[s] ? spectral_[s]->method() : "ksp (" + why + ")").c_str());
   }
 }
 

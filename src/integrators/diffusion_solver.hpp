@@ -30,6 +30,7 @@
 #include "grid/stencil.hpp"
 #include "operators/operator_matrices.hpp"
 #include "operators/spectral_solver.hpp"
+#include "operators/tridiagonal_solver.hpp"
 
 #include <cmath>
 #include <memory>
@@ -67,7 +68,9 @@ public:
 
 private:
   void configure(int s);
-  void choose_spectral(const std::string& mode, const std::vector<std::string>& varying);
+  void choose_spectral(const std::string& mode, const std::string& slow,
+                       const std::vector<std::string>& varying);
+  std::unique_ptr<ExactSolve> exact_for(int s, const std::string& slow, std::string* why);
   bool use_spectral(int s);
   void prepare_species(int s, double dt, double theta);
 
@@ -76,8 +79,8 @@ private:
   std::vector<std::string> species_;
   std::vector<KSPH> ksp_; // (PETSc reference-counts the operators they hold)
   std::vector<MatH> A_;
-  std::vector<std::unique_ptr<SpectralSolver>> spectral_; // null: KSP
-  std::vector<Mat> spectral_mat_;                         // the M_s it was checked on
+  std::vector<std::unique_ptr<ExactSolve>> spectral_; // null: KSP
+  std::vector<Mat> spectral_mat_;                     // the M_s it was checked on
   std::vector<double> assembled_dt_, assembled_theta_;
   std::vector<PetscInt> iterations_;
   PetscInt total_its_ = 0;

@@ -7,10 +7,7 @@
 
 namespace morphogen {
 
-namespace {
-
-// A deterministic, non-smooth test vector (every mode present), a function of the global cell.
-void fill_probe(const Grid& grid, Vec x) {
+void fill_spectral_probe(const Grid& grid, Vec x) {
   const Box& ob = grid.owned();
   PetscScalar* a;
   MG_PETSC(VecGetArray(x, &a));
@@ -22,6 +19,8 @@ void fill_probe(const Grid& grid, Vec x) {
       }
   MG_PETSC(VecRestoreArray(x, &a));
 }
+
+namespace {
 
 double max_all(MPI_Comm comm, double v) {
   double r = v;
@@ -86,7 +85,7 @@ bool SpectralSolver::measure_symbol(const Grid& grid, Mat M, std::string* why) {
 bool SpectralSolver::check_product(const Grid& grid, Mat M, std::string* why) {
   SpectralTransform& t = *t_;
   VecH x = grid.create_global(), y = grid.create_global(), z = grid.create_global();
-  fill_probe(grid, x);
+  fill_spectral_probe(grid, x);
   MG_PETSC(MatMult(M, x, y));
   t.forward(x);
   double* sp = t.spectrum();

@@ -21,6 +21,7 @@
 #pragma once
 
 #include "grid/spectral_transform.hpp"
+#include "operators/exact_solve.hpp"
 
 #include <memory>
 #include <petscmat.h>
@@ -29,21 +30,26 @@
 
 namespace morphogen {
 
-class SpectralSolver {
+// A deterministic, non-smooth test vector (every mode present), a function of the global cell:
+// the probe of the exactness checks at setup.
+void fill_spectral_probe(const Grid& grid, Vec x);
+
+class SpectralSolver : public ExactSolve {
 public:
   // Null (and *why set) when M is not diagonalised by the transform on this grid with these
   // axis kinds (default: the grid's boundaries, axis_kinds()).
   static std::unique_ptr<SpectralSolver> create(const Grid& grid, Mat M, std::string* why);
   static std::unique_ptr<SpectralSolver> create(const Grid& grid, Mat M, std::string* why,
                                                 const std::array<AxisKind, 3>& kinds);
-  ~SpectralSolver();
+  ~SpectralSolver() override;
   SpectralSolver(const SpectralSolver&) = delete;
   SpectralSolver& operator=(const SpectralSolver&) = delete;
 
   // u <- (I - theta c M)^-1 (I + (1 - theta) c M) u, in place on a global Vec.
-  void step(Vec u, double c, double theta);
+  void step(Vec u, double c, double theta) override;
   // x = (I - theta c M)^-1 r (the Dirichlet data's part of a substep).
-  void solve_shifted(Vec r, Vec x, double c, double theta);
+  void solve_shifted(Vec r, Vec x, double c, double theta) override;
+  std::string method() const override { return "spectral (FFT/DCT, exact)"; }
   // x = (-M)^+ r: the solution of -M x = r without null modes (r must be orthogonal to them).
   void solve_negated(Vec r, Vec x);
 

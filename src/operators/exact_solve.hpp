@@ -1,0 +1,23 @@
+// A direct (non-iterative) implicit diffusion substep with a constant-coefficient operator M,
+// exact to rounding (no tolerance):
+//   step:           u <- (I - theta c M)^-1 (I + (1 - theta) c M) u
+//   solve_shifted:  x  = (I - theta c M)^-1 r
+// Implementations: operators/spectral_solver.hpp (transform on every axis),
+// operators/tridiagonal_solver.hpp (transform across, tridiagonal along the slowest axis).
+#pragma once
+
+#include <petscvec.h>
+#include <string>
+
+namespace morphogen {
+
+class ExactSolve {
+public:
+  virtual ~ExactSolve() = default;
+  virtual void step(Vec u, double c, double theta) = 0;
+  virtual void solve_shifted(Vec r, Vec x, double c, double theta) = 0;
+  // For the setup log, e.g. "spectral (FFT/DCT, exact)".
+  virtual std::string method() const = 0;
+};
+
+} // namespace morphogen

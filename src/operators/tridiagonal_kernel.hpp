@@ -1,0 +1,46 @@
+// Row kernels of the slow-axis tridiagonal solve (pure kernels: no PETSc, MPI, allocation).
+// A row is n lanes (spectral entries of one plane, real and imaginary parts as separate lanes);
+// the coefficients are per lane. The system along the slow axis, per lane:
+//   a x_{j-1} + b_j x_j + g x_{j+1} = f_j.
+// Thomas elimination of an interior block (rows 1 .. n_i, no pivoting: the matrices here are
+// strictly diagonally dominant): forward  y_1 = f_1 inv_1,  y_j = (f_j - a y_{j-1}) inv_j,
+// backward  x_j = y_j - gp_j x_{j+1},  with inv_j = 1 / (b - a gp_{j-1}), gp_j = g inv_j.
+#pragma once
+
+namespace morphogen {
+
+// out = s0 cur + s1 (a prev + b cur + g next) (out may alias cur).
+inline void tri_multiply_row(int n, double s0, double s1, const double* a, const double* b,
+                             const double* g, const double* prev, const double* cur,
+                             const double* next, double* out) {
+  for (int l = 0; l < n; ++l)
+    out[l] = s0 * cur[l] + s1 * ((a[l] * prev[l] + b[l] * cur[l]) + g[l] * next[l]);
+}
+
+// Forward elimination step: cur = (cur - a prev) inv (prev null: the first row, cur = cur inv).
+inline void tri_forward_row(int n, const double* a, const double* inv, const double* prev,
+                            double* cur) {
+  if (!prev) {
+    for (int l = 0; l < n; ++l)
+      cur[l] *= inv[l];
+    return;
+  }
+  for (int l = 0; l < n; ++l)
+    cur[l] = (cur[l] - a[l] * prev[l]) * inv[l];
+}
+
+// Back substitution step: cur -= gp next.
+inline void tri_backward_row(int n, const double* gp, const double* next, double* cur) {
+  for (int l = 0; l < n; ++l)
+    cur[l] -= gp[l] * next[l];
+}
+
+// The interior's answer from its particular solution y and the block's end values:
+// cur = scale (y - a F p - g E q).
+inline void tri_spike_row(int n, double scale, const double* a, const double* g, const double* F,
+                          const double* E, const double* p, const double* q, double* cur) {
+  for (int l = 0; l < n; ++l)
+    cur[l] = scale * (cur[l] - (a[l] * F[l] * p[l] + g[l] * E[l] * q[l]));
+}
+
+} // namespace morphogen

@@ -1,0 +1,349 @@
+#include "operators/tridiagonal_solver.hpp"
+
+#include "core/petsc_handle.hpp"
+#include "operators/spectral_solver.hpp"
+#include "operators/tridiagonal_kernel.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+// LAPACK (Fortran): solve A X = B by LU with partial pivoting.
+extern "C" void dgesv_(const int* n, const int* nrhs, double* a, const int* lda, int* ipiv,
+                       double* b, const int* ldb, int* info);
+
+namespace morphogen {
+
+TridiagonalSolver::TridiagonalSolver(const Grid& grid, std::unique_ptr<SpectralTransform> t)
+    : grid_(grid), t_(std::move(t)), comm_(grid.comm()) {
+  MPI_Comm_rank(comm_, &rank_);
+  MPI_Comm_size(comm_, &size_);
+  w_ = t_->width();
+  periodic_ = axis_kinds(grid)[grid.dim() - 1] == AxisKind::Periodic;
+  S_ = t_->slow_cells();
+  a0_ = t_->first_plane();
+  m_ = t_->planes();
+  n_ = static_cast<int>(t_->columns()) * w_;
+  lo_.assign(static_cast<size_t>(n_), 0.0);
+  hi_ = lo_;
+}
+
+TridiagonalSolver::~TridiagonalSolver() = default;
+
+std::unique_ptr<TridiagonalSolver> TridiagonalSolver::create(const Grid& grid, Mat M,
+                                                             std::string* why) {
+  int size = 1;
+  MPI_Comm_size(grid.comm(), &size);
+  const PetscInt S = grid.spec().n[grid.dim() - 1];
+  if (size > kMaxRanks || S < 3) {
+    *why = size > kMaxRanks ? "more than " + std::to_string(kMaxRanks) + " ranks"
+                            : "fewer than 3 cells along the slowest axis";
+    return nullptr;
+  }
+  auto t = std::make_unique<SpectralTransform>(grid, axis_kinds(grid), true);
+  int planes = static_cast<int>(t->planes());
+  MPI_Allreduce(MPI_IN_PLACE, &planes, 1, MPI_INT, MPI_MIN, grid.comm());
+  if (planes < 2) {
+    *why = "a rank holds fewer than 2 planes of the slowest axis";
+    return nullptr;
+  }
+  std::unique_ptr<TridiagonalSolver> ts(new TridiagonalSolver(grid, std::move(t)));
+  if (!ts->measure(M, why) || !ts->dominant(why) || !ts->check_product(M, why)) return nullptr;
+  return ts;
+}
+
+std::string TridiagonalSolver::method() const {
+  return std::string("spectral (FFT/DCT across, tridiagonal along ") +
+         (grid_.dim() == 3 ? "z" : "y") + ", exact)";
+}
+
+// out[r][lane] = (T_rest M T_rest^-1 e_j0)(row j0 + r - 1) / norm for r = 0, 1, 2 (rows off a
+// non-periodic axis stay 0), summed over the ranks; *imag: the largest imaginary part.
+void TridiagonalSolver::probe_plane(Mat M, PetscInt j0, std::vector<double>& out, double* imag) {
+  SpectralTransform& t = *t_;
+  double* sp = t.spectrum();
+  std::fill(sp, sp + static_cast<size_t>(m_) * static_cast<size_t>(n_), 0.0);
+  if (j0 >= a0_ && j0 < a0_ + m_)
+    for (int l = 0; l < n_; l += w_)
+      row(j0 - a0_)[l] = 1.0;
+  VecH v = grid_.create_global(), y = grid_.create_global();
+  t.backward(v);
+  MG_PETSC(MatMult(M, v, y));
+  t.forward(y);
+  out.assign(3 * static_cast<size_t>(n_), 0.0);
+  double im = 0.0;
+  for (int r = 0; r < 3; ++r) {
+    PetscInt j = j0 + r - 1;
+    if (periodic_) j = (j + S_) % S_;
+    if (j < a0_ || j >= a0_ + m_) continue;
+    const double* y_j = row(j - a0_);
+    for (int l = 0; l < n_; ++l) {
+      const int k = l - l % w_; // the column's real part
+      out[static_cast<size_t>(r * n_ + l)] = y_j[k] / t.norm();
+      if (w_ == 2) im = std::max(im, std::fabs(y_j[k + 1]) / t.norm());
+    }
+  }
+  MPI_Allreduce(MPI_IN_PLACE, out.data(), 3 * n_, MPI_DOUBLE, MPI_SUM, comm_);
+  MPI_Allreduce(MPI_IN_PLACE, &im, 1, MPI_DOUBLE, MPI_MAX, comm_);
+  *imag = std::max(*imag, im);
+}
+
+// a, b, g from a probe of an interior plane, bF and bL from the first and the last plane.
+bool TridiagonalSolver::measure(Mat M, std::string* why) {
+  std::vector<double> r;
+  double imag = 0.0;
+  const size_t n = static_cast<size_t>(n_);
+  probe_plane(M, S_ / 2, r, &imag);
+  g_.assign(r.begin(), r.begin() + n);
+  b_.assign(r.begin() + n, r.begin() + 2 * n);
+  a_.assign(r.begin() + 2 * n, r.end());
+  probe_plane(M, 0, r, &imag);
+  bF_.assign(r.begin() + n, r.begin() + 2 * n);
+  probe_plane(M, S_ - 1, r, &imag);
+  bL_.assign(r.begin() + n, r.begin() + 2 * n);
+  double scale = 0.0;
+  for (size_t l = 0; l < n; ++l)
+    scale = std::max(scale, std::fabs(a_[l]) + std::fabs(b_[l]) + std::fabs(g_[l]));
+  if (!(scale > 0.0) || !(imag <= 1e-12 * scale)) {
+    *why = "the operator couples the slowest axis to the others (cross terms)";
+    return false;
+  }
+  return true;
+}
+
+// Every column weakly diagonally dominant with a non-positive diagonal (to 1e-12 of the scale),
+// so that I - theta c M is strictly dominant for every theta c >= 0.
+bool TridiagonalSolver::dominant(std::string* why) const {
+  int ok = 1;
+  for (size_t l = 0; l < static_cast<size_t>(n_); ++l) {
+    const double aa = std::fabs(a_[l]), gg = std::fabs(g_[l]);
+    const double tol = 1e-12 * (aa + gg + std::fabs(b_[l]));
+    ok &= -b_[l] >= aa + gg - tol && -bF_[l] >= gg + (periodic_ ? aa : 0.0) - tol &&
+                  -bL_[l] >= aa + (periodic_ ? gg : 0.0) - tol
+              ? 1
+              : 0;
+  }
+  MPI_Allreduce(MPI_IN_PLACE, &ok, 1, MPI_INT, MPI_LAND, comm_);
+  if (!ok) *why = "the operator is not diagonally dominant along the slowest axis";
+  return ok != 0;
+}
+
+// M x against T_rest^-1 (tridiagonal product of T_rest x) for a probe x.
+bool TridiagonalSolver::check_product(Mat M, std::string* why) {
+  VecH x = grid_.create_global(), y = grid_.create_global(), z = grid_.create_global();
+  fill_spectral_probe(grid_, x);
+  MG_PETSC(MatMult(M, x, y));
+  t_->forward(x);
+  multiply(0.0, 1.0 / t_->norm());
+  t_->backward(z);
+  double scale = 0.0;
+  for (size_t l = 0; l < static_cast<size_t>(n_); ++l)
+    scale = std::max(scale, std::fabs(a_[l]) + std::fabs(b_[l]) + std::fabs(g_[l]));
+  MPI_Allreduce(MPI_IN_PLACE, &scale, 1, MPI_DOUBLE, MPI_MAX, comm_);
+  PetscReal dnorm;
+  MG_PETSC(VecAXPY(z, -1.0, y));
+  MG_PETSC(VecNorm(z, NORM_INFINITY, &dnorm));
+  if (!(dnorm <= 1e-10 * scale * 1.5)) { // |probe| <= 1.1
+    *why = "the operator is not a constant-coefficient stencil, tridiagonal along the slowest "
+           "axis (M x differs from the product by " +
+           std::to_string(dnorm) + ")";
+    return false;
+  }
+  return true;
+}
+
+// lo_ = plane a0 - 1, hi_ = plane a0 + m (wrapped when periodic; zero off the axis).
+void TridiagonalSolver::exchange_edges() {
+  const int left = rank_ > 0 ? rank_ - 1 : periodic_ ? size_ - 1 : MPI_PROC_NULL;
+  const int right = rank_ < size_ - 1 ? rank_ + 1 : periodic_ ? 0 : MPI_PROC_NULL;
+  std::fill(lo_.begin(), lo_.end(), 0.0);
+  std::fill(hi_.begin(), hi_.end(), 0.0);
+  MPI_Sendrecv(row(m_ - 1), n_, MPI_DOUBLE, right, 0, lo_.data(), n_, MPI_DOUBLE, left, 0, comm_,
+               MPI_STATUS_IGNORE);
+  MPI_Sendrecv(row(0), n_, MPI_DOUBLE, left, 1, hi_.data(), n_, MPI_DOUBLE, right, 1, comm_,
+               MPI_STATUS_IGNORE);
+}
+
+const double* TridiagonalSolver::diagonal(PetscInt j) const {
+  const PetscInt gj = a0_ + j;
+  return gj == 0 ? bF_.data() : gj == S_ - 1 ? bL_.data() : b_.data();
+}
+
+void TridiagonalSolver::multiply(double s0, double s1) {
+  exchange_edges();
+  std::vector<double> prev(lo_), cur(static_cast<size_t>(n_));
+  for (PetscInt j = 0; j < m_; ++j) {
+    double* y = row(j);
+    const double* next = j + 1 < m_ ? row(j + 1) : hi_.data();
+    std::copy(y, y + n_, cur.begin());
+    tri_multiply_row(n_, s0, s1, a_.data(), diagonal(j), g_.data(), prev.data(), cur.data(), next,
+                     y);
+    std::swap(prev, cur);
+  }
+}
+
+void TridiagonalSolver::factor(double c, double theta) {
+  if (c == fc_ && theta == ftheta_) return;
+  const size_t n = static_cast<size_t>(n_);
+  ia_.resize(n);
+  ig_.resize(n);
+  ib_.resize(n);
+  ifirst_.resize(n);
+  ilast_.resize(n);
+  const double* bf = diagonal(0);
+  const double* bl = diagonal(m_ - 1);
+  for (size_t l = 0; l < n; ++l) {
+    ia_[l] = -theta * c * a_[l];
+    ig_[l] = -theta * c * g_[l];
+    ib_[l] = 1.0 - theta * c * b_[l];
+    ifirst_[l] = 1.0 - theta * c * bf[l];
+    ilast_[l] = 1.0 - theta * c * bl[l];
+  }
+  interior_factors();
+  reduced_inverse();
+  fc_ = c;
+  ftheta_ = theta;
+}
+
+// Thomas factors of the interior block (rows 1 .. m-2, diagonal ib) and its spikes p, q.
+// Spike entries below 1e-290 (they decay geometrically away from their row) are set to 0 so
+// that no subnormal number reaches the solves.
+void TridiagonalSolver::interior_factors() {
+  const size_t n = static_cast<size_t>(n_), ni = static_cast<size_t>(m_ - 2);
+  inv_.assign(ni * n, 0.0);
+  gp_.assign(ni * n, 0.0);
+  p_.assign(ni * n, 0.0);
+  q_.assign(ni * n, 0.0);
+  if (ni == 0) return;
+  for (size_t i = 0; i < ni; ++i)
+    for (size_t l = 0; l < n; ++l) {
+      const double den = ib_[l] - (i > 0 ? ia_[l] * gp_[(i - 1) * n + l] : 0.0);
+      inv_[i * n + l] = 1.0 / den;
+      gp_[i * n + l] = ig_[l] * inv_[i * n + l];
+    }
+  auto tiny = [](double& v) {
+    if (std::fabs(v) < 1e-290) v = 0.0;
+  };
+  for (size_t i = 0; i < ni; ++i) // forward sweeps of e_first and e_last
+    for (size_t l = 0; l < n; ++l) {
+      p_[i * n + l] = i == 0 ? inv_[l] : -ia_[l] * p_[(i - 1) * n + l] * inv_[i * n + l];
+      q_[i * n + l] = i + 1 == ni ? inv_[i * n + l] : 0.0;
+    }
+  for (size_t i = ni - 1; i-- > 0;) // back substitution
+    for (size_t l = 0; l < n; ++l) {
+      p_[i * n + l] -= gp_[i * n + l] * p_[(i + 1) * n + l];
+      q_[i * n + l] -= gp_[i * n + l] * q_[(i + 1) * n + l];
+    }
+  std::for_each(p_.begin(), p_.end(), tiny);
+  std::for_each(q_.begin(), q_.end(), tiny);
+}
+
+// This rank's two rows of the reduced matrix, per lane: the coupling of F to the previous
+// block's E, S_FF, S_FE, S_EF, S_EE, the coupling of E to the next block's F.
+std::vector<double> TridiagonalSolver::reduced_rows() const {
+  const size_t n = static_cast<size_t>(n_), ni = static_cast<size_t>(m_ - 2);
+  std::vector<double> r(6 * n);
+  for (size_t l = 0; l < n; ++l) {
+    const double a = ia_[l], g = ig_[l];
+    const bool inner = ni > 0;
+    r[l] = rank_ > 0 || periodic_ ? a : 0.0;
+    r[n + l] = inner ? ifirst_[l] - g * a * p_[l] : ifirst_[l];
+    r[2 * n + l] = inner ? -g * g * q_[l] : g;
+    r[3 * n + l] = inner ? -a * a * p_[(ni - 1) * n + l] : a;
+    r[4 * n + l] = inner ? ilast_[l] - a * g * q_[(ni - 1) * n + l] : ilast_[l];
+    r[5 * n + l] = rank_ < size_ - 1 || periodic_ ? g : 0.0;
+  }
+  return r;
+}
+
+// The reduced system (unknowns F_0, E_0, F_1, ..., E_{P-1}: the first and last row of every
+// block) from every rank's rows; per lane, my two rows of its inverse: S^T X = (e_2r, e_2r+1).
+void TridiagonalSolver::reduced_inverse() {
+  const size_t n = static_cast<size_t>(n_);
+  const int K = 2 * size_;
+  const std::vector<double> mine = reduced_rows();
+  std::vector<double> all(mine.size() * static_cast<size_t>(size_));
+  MPI_Allgather(mine.data(), 6 * n_, MPI_DOUBLE, all.data(), 6 * n_, MPI_DOUBLE, comm_);
+  rinv_.assign(2 * static_cast<size_t>(K) * n, 0.0);
+  std::vector<double> A(static_cast<size_t>(K * K)), X(2 * static_cast<size_t>(K));
+  std::vector<int> piv(static_cast<size_t>(K));
+  for (size_t l = 0; l < n; ++l) {
+    std::fill(A.begin(), A.end(), 0.0);
+    auto add = [&](int r, int c, double v) { A[static_cast<size_t>(c + r * K)] += v; }; // S^T
+    for (int q = 0; q < size_; ++q) {
+      const double* e = all.data() + 6 * n * static_cast<size_t>(q) + l;
+      const int F = 2 * q, E = 2 * q + 1;
+      add(F, (F - 1 + K) % K, e[0]);
+      add(F, F, e[n]);
+      add(F, E, e[2 * n]);
+      add(E, F, e[3 * n]);
+      add(E, E, e[4 * n]);
+      add(E, (E + 1) % K, e[5 * n]);
+    }
+    std::fill(X.begin(), X.end(), 0.0);
+    X[static_cast<size_t>(2 * rank_)] = 1.0;
+    X[static_cast<size_t>(K + 2 * rank_ + 1)] = 1.0;
+    const int two = 2;
+    int info = 0;
+    dgesv_(&K, &two, A.data(), &K, piv.data(), X.data(), &K, &info);
+    if (info != 0) throw std::runtime_error("tridiagonal solve: singular reduced system");
+    for (int k = 0; k < 2 * K; ++k)
+      rinv_[static_cast<size_t>(k) * n + l] = X[static_cast<size_t>(k)];
+  }
+}
+
+// spectrum <- scale G^-1 spectrum, G = I - theta c M (factored): the interior of the block by
+// Thomas, the block's ends from the reduced system, the interior corrected by the spikes.
+void TridiagonalSolver::solve(double scale) {
+  const size_t n = static_cast<size_t>(n_);
+  const PetscInt ni = m_ - 2;
+  for (PetscInt i = 0; i < ni; ++i)
+    tri_forward_row(n_, ia_.data(), &inv_[static_cast<size_t>(i) * n], i > 0 ? row(i) : nullptr,
+                    row(i + 1));
+  for (PetscInt i = ni - 1; i-- > 0;)
+    tri_backward_row(n_, &gp_[static_cast<size_t>(i) * n], row(i + 2), row(i + 1));
+  gmine_.resize(2 * n);
+  const double *f0 = row(0), *f1 = row(1), *fe = row(m_ - 1), *fe1 = row(m_ - 2);
+  for (size_t l = 0; l < n; ++l) {
+    gmine_[l] = ni > 0 ? f0[l] - ig_[l] * f1[l] : f0[l];
+    gmine_[n + l] = ni > 0 ? fe[l] - ia_[l] * fe1[l] : fe[l];
+  }
+  const int K = 2 * size_;
+  gall_.resize(static_cast<size_t>(K) * n);
+  MPI_Allgather(gmine_.data(), 2 * n_, MPI_DOUBLE, gall_.data(), 2 * n_, MPI_DOUBLE, comm_);
+  std::vector<double> F(n, 0.0), E(n, 0.0);
+  for (int k = 0; k < K; ++k) {
+    const double* gk = &gall_[static_cast<size_t>(k) * n];
+    const double* rf = &rinv_[static_cast<size_t>(k) * n];
+    const double* re = &rinv_[static_cast<size_t>(K + k) * n];
+    for (size_t l = 0; l < n; ++l) {
+      F[l] += rf[l] * gk[l];
+      E[l] += re[l] * gk[l];
+    }
+  }
+  for (PetscInt i = 0; i < ni; ++i)
+    tri_spike_row(n_, scale, ia_.data(), ig_.data(), F.data(), E.data(),
+                  &p_[static_cast<size_t>(i) * n], &q_[static_cast<size_t>(i) * n], row(i + 1));
+  double *x0 = row(0), *xe = row(m_ - 1);
+  for (size_t l = 0; l < n; ++l) {
+    x0[l] = scale * F[l];
+    xe[l] = scale * E[l];
+  }
+}
+
+void TridiagonalSolver::step(Vec u, double c, double theta) {
+  factor(c, theta);
+  t_->forward(u);
+  if (theta != 1.0) multiply(1.0, (1.0 - theta) * c);
+  solve(1.0 / t_->norm());
+  t_->backward(u);
+}
+
+void TridiagonalSolver::solve_shifted(Vec r, Vec x, double c, double theta) {
+  factor(c, theta);
+  t_->forward(r);
+  solve(1.0 / t_->norm());
+  t_->backward(x);
+}
+
+} // namespace morphogen

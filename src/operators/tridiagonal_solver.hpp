@@ -1,0 +1,84 @@
+// Exact implicit diffusion substeps (operators/exact_solve.hpp) by a transform of the fast axes
+// and a tridiagonal solve along the slowest axis (y in 2-D, z in 3-D). For a constant-coefficient
+// stencil without cross terms between the slowest and the other axes, T_rest (DFT on periodic,
+// DCT-II / DST-II on zero-flux / Dirichlet fast axes; grid/spectral_transform.hpp, rest_only)
+// turns M into one tridiagonal matrix per spectral column k along the slowest axis:
+//
+//   (T_rest M u)_j = a_k u_{j-1} + b_k u_j + g_k u_{j+1}   (first / last row: diagonal bF_k,
+//   bL_k and no outer neighbour; periodic: the neighbours wrap),
+//
+// solved with I - theta c M by elimination, exactly (no iteration, no tolerance). The
+// coefficients are measured, not assumed (M applied to three plane probes), and the model is
+// checked at setup as in spectral_solver.hpp: the coefficients are real (no cross terms), every
+// column is diagonally dominant, and M x equals the tridiagonal product for a probe x to 1e-10
+// of the operator's scale. Against the full transform it saves the slowest axis' FFT and both
+// transposes between the ranks.
+//
+// Parallel, layout A (each rank a block of m >= 2 whole planes): per column the interior rows of
+// every block are eliminated (Thomas, no pivoting: I - theta c M is strictly diagonally
+// dominant), leaving a reduced system for the first and last row of each block, 2P unknowns
+// (cyclic when the slowest axis is periodic). Its right-hand sides are allgathered (2 planes per
+// rank) and each rank forms its two unknowns from its two rows of the reduced inverse (LAPACK
+// dgesv at setup, once per (c, theta)); the interior follows from the spikes
+// p = A_I^-1 e_first, q = A_I^-1 e_last. The explicit half of Crank-Nicolson is the tridiagonal
+// product with the neighbouring ranks' edge planes. create() returns null and says why where it
+// does not apply (at most kMaxRanks ranks, S >= 3 planes); the caller then uses the full
+// transform (spectral_solver.hpp) or KSP.
+#pragma once
+
+#include "grid/spectral_transform.hpp"
+#include "operators/exact_solve.hpp"
+
+#include <memory>
+#include <petscmat.h>
+#include <string>
+#include <vector>
+
+namespace morphogen {
+
+class TridiagonalSolver : public ExactSolve {
+public:
+  static constexpr int kMaxRanks = 64;
+  static std::unique_ptr<TridiagonalSolver> create(const Grid& grid, Mat M, std::string* why);
+  ~TridiagonalSolver() override;
+  TridiagonalSolver(const TridiagonalSolver&) = delete;
+  TridiagonalSolver& operator=(const TridiagonalSolver&) = delete;
+
+  void step(Vec u, double c, double theta) override;
+  void solve_shifted(Vec r, Vec x, double c, double theta) override;
+  std::string method() const override;
+
+private:
+  TridiagonalSolver(const Grid& grid, std::unique_ptr<SpectralTransform> t);
+  void probe_plane(Mat M, PetscInt j0, std::vector<double>& out, double* imag);
+  bool measure(Mat M, std::string* why);
+  bool dominant(std::string* why) const;
+  bool check_product(Mat M, std::string* why);
+  void exchange_edges();
+  void multiply(double s0, double s1); // spectrum <- s0 y + s1 M y
+  void factor(double c, double theta);
+  void interior_factors();
+  std::vector<double> reduced_rows() const;
+  void reduced_inverse();
+  void solve(double scale); // spectrum <- scale (I - theta c M)^-1 spectrum
+  double* row(PetscInt j) { return t_->spectrum() + j * n_; }
+  const double* diagonal(PetscInt j) const; // M's diagonal of my row j
+
+  const Grid& grid_;
+  std::unique_ptr<SpectralTransform> t_;
+  MPI_Comm comm_ = MPI_COMM_NULL;
+  int rank_ = 0, size_ = 1, w_ = 1;
+  bool periodic_ = false;
+  PetscInt S_ = 0, a0_ = 0, m_ = 0;
+  int n_ = 0;                               // lanes per plane (spectral columns x width)
+  std::vector<double> a_, b_, g_, bF_, bL_; // M's coefficients per lane
+  std::vector<double> lo_, hi_;             // the neighbours' edge planes (zero outside)
+  double fc_ = -1.0, ftheta_ = -1.0;        // (c, theta) of the factors below
+  // I - theta c M: off-diagonals, interior diagonal, the diagonals of my first and last row
+  std::vector<double> ia_, ig_, ib_, ifirst_, ilast_;
+  std::vector<double> inv_, gp_, p_, q_; // [interior row][lane]
+  std::vector<double> rinv_;             // [2][2P][lane]: my rows of the reduced inverse
+  std::vector<double> gmine_, gall_;
+};
+
+} // namespace morphogen
