@@ -44,16 +44,21 @@ DiffusionSolver::DiffusionSolver(const Grid& grid, const OperatorMatrices& ops,
                  "the spectral solve along the slowest axis (y in 2-D, z in 3-D): tridiagonal "
                  "(elimination after the transform of the other axes: no FFT along it and no "
                  "transposes between the ranks; up to 64 ranks, no cross terms with it), fft "
-                 "(the full transform), or auto (tridiagonal where it applies, else fft)"),
+                 "(the full transform), or auto (tridiagonal where it applies, except on one "
+                 "rank in 3-D; else fft)"),
       varying);
 }
 
-// The exact solve of species s: tridiagonal along the slowest axis (slow: auto, tridiagonal) or
-// the full transform (auto where the tridiagonal one does not apply, fft); null and *why if none.
+// The exact solve of species s: tridiagonal along the slowest axis (tridiagonal; auto except on
+// one rank in 3-D, where the full transform measured faster: README, Performance) or the full
+// transform (fft, and auto where the tridiagonal one does not apply); null and *why if none.
 std::unique_ptr<ExactSolve> DiffusionSolver::exact_for(int s, const std::string& slow,
                                                        std::string* why) {
+  int size = 1;
+  MPI_Comm_size(grid_.comm(), &size);
+  const bool full_first = slow == "fft" || (slow == "auto" && size == 1 && grid_.dim() == 3);
   std::string why_tri;
-  if (slow != "fft")
+  if (!full_first)
     if (auto t = TridiagonalSolver::create(grid_, ops_.M(s), &why_tri)) return t;
   if (slow == "tridiagonal")
     throw UserError("-diffusion_slow_axis tridiagonal: species " + species_[s] + ": " + why_tri +
