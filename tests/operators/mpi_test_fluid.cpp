@@ -226,7 +226,9 @@ TEST(Fluid, ObstacleHasZeroVelocityInside) {
     flux_out += u[static_cast<size_t>(47 + 48 * j)] / 48.0;
   }
   EXPECT_TRUE(all_ranks(ok));
-  if (!u.empty()) EXPECT_NEAR(flux_out, 1.0, 0.02) << "outflow flux (inflow 1)";
+  if (!u.empty()) {
+    EXPECT_NEAR(flux_out, 1.0, 0.02) << "outflow flux (inflow 1)";
+  }
 }
 
 TEST(Fluid, RankCountIndependent) {
