@@ -205,35 +205,59 @@ void TridiagonalSolver::factor(double c, double theta) {
   ftheta_ = theta;
 }
 
-// Thomas factors of the interior block (rows 1 .. m-2, diagonal ib) and its spikes p, q.
-// Spike entries below 1e-290 (they decay geometrically away from their row) are set to 0 so
-// that no subnormal number reaches the solves.
-void TridiagonalSolver::interior_factors() {
+// Thomas factors of the interior block (rows 1 .. m-2, diagonal ib): inv_i = 1 / (ib - ia
+// gp_{i-1}), gp_i = ig inv_i. The recurrence reaches its fixed point in floating point within a few
+// hundred rows (it contracts); from the first row equal to its predecessor in every lane on,
+// all rows are that row, so only the rows before it are kept (nfac_; inv_row / gp_row).
+void TridiagonalSolver::thomas_factors() {
   const size_t n = static_cast<size_t>(n_), ni = static_cast<size_t>(m_ - 2);
   inv_.assign(ni * n, 0.0);
   gp_.assign(ni * n, 0.0);
-  p_.assign(ni * n, 0.0);
-  q_.assign(ni * n, 0.0);
-  if (ni == 0) return;
-  for (size_t i = 0; i < ni; ++i)
+  nfac_ = static_cast<PetscInt>(ni);
+  for (size_t i = 0; i < ni; ++i) {
     for (size_t l = 0; l < n; ++l) {
       const double den = ib_[l] - (i > 0 ? ia_[l] * gp_[(i - 1) * n + l] : 0.0);
       inv_[i * n + l] = 1.0 / den;
       gp_[i * n + l] = ig_[l] * inv_[i * n + l];
     }
+    if (i > 0 && std::equal(&inv_[i * n], &inv_[i * n] + n, &inv_[(i - 1) * n]) &&
+        std::equal(&gp_[i * n], &gp_[i * n] + n, &gp_[(i - 1) * n])) {
+      nfac_ = static_cast<PetscInt>(i);
+      break;
+    }
+  }
+  inv_.resize(static_cast<size_t>(nfac_) * n);
+  gp_.resize(static_cast<size_t>(nfac_) * n);
+  inv_.shrink_to_fit();
+  gp_.shrink_to_fit();
+}
+
+// The Thomas factors and the interior's spikes p = A_I^-1 e_first, q = A_I^-1 e_last. Spike
+// entries below 1e-290 (they decay geometrically away from their row) are set to 0 so that no
+// subnormal number reaches the solves.
+void TridiagonalSolver::interior_factors() {
+  const size_t n = static_cast<size_t>(n_), ni = static_cast<size_t>(m_ - 2);
+  thomas_factors();
+  p_.assign(ni * n, 0.0);
+  q_.assign(ni * n, 0.0);
+  if (ni == 0) return;
   auto tiny = [](double& v) {
     if (std::fabs(v) < 1e-290) v = 0.0;
   };
-  for (size_t i = 0; i < ni; ++i) // forward sweeps of e_first and e_last
+  for (size_t i = 0; i < ni; ++i) { // forward sweeps of e_first and e_last
+    const double* inv = inv_row(static_cast<PetscInt>(i));
     for (size_t l = 0; l < n; ++l) {
-      p_[i * n + l] = i == 0 ? inv_[l] : -ia_[l] * p_[(i - 1) * n + l] * inv_[i * n + l];
-      q_[i * n + l] = i + 1 == ni ? inv_[i * n + l] : 0.0;
+      p_[i * n + l] = i == 0 ? inv[l] : -ia_[l] * p_[(i - 1) * n + l] * inv[l];
+      q_[i * n + l] = i + 1 == ni ? inv[l] : 0.0;
     }
-  for (size_t i = ni - 1; i-- > 0;) // back substitution
+  }
+  for (size_t i = ni - 1; i-- > 0;) { // back substitution
+    const double* gp = gp_row(static_cast<PetscInt>(i));
     for (size_t l = 0; l < n; ++l) {
-      p_[i * n + l] -= gp_[i * n + l] * p_[(i + 1) * n + l];
-      q_[i * n + l] -= gp_[i * n + l] * q_[(i + 1) * n + l];
+      p_[i * n + l] -= gp[l] * p_[(i + 1) * n + l];
+      q_[i * n + l] -= gp[l] * q_[(i + 1) * n + l];
     }
+  }
   std::for_each(p_.begin(), p_.end(), tiny);
   std::for_each(q_.begin(), q_.end(), tiny);
 }
@@ -298,10 +322,9 @@ void TridiagonalSolver::solve(double scale) {
   const size_t n = static_cast<size_t>(n_);
   const PetscInt ni = m_ - 2;
   for (PetscInt i = 0; i < ni; ++i)
-    tri_forward_row(n_, ia_.data(), &inv_[static_cast<size_t>(i) * n], i > 0 ? row(i) : nullptr,
-                    row(i + 1));
+    tri_forward_row(n_, ia_.data(), inv_row(i), i > 0 ? row(i) : nullptr, row(i + 1));
   for (PetscInt i = ni - 1; i-- > 0;)
-    tri_backward_row(n_, &gp_[static_cast<size_t>(i) * n], row(i + 2), row(i + 1));
+    tri_backward_row(n_, gp_row(i), row(i + 2), row(i + 1));
   gmine_.resize(2 * n);
   const double *f0 = row(0), *f1 = row(1), *fe = row(m_ - 1), *fe1 = row(m_ - 2);
   for (size_t l = 0; l < n; ++l) {

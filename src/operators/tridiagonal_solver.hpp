@@ -29,6 +29,7 @@
 #include "grid/spectral_transform.hpp"
 #include "operators/exact_solve.hpp"
 
+#include <algorithm>
 #include <memory>
 #include <petscmat.h>
 #include <string>
@@ -57,6 +58,7 @@ private:
   void exchange_edges();
   void multiply(double s0, double s1); // spectrum <- s0 y + s1 M y
   void factor(double c, double theta);
+  void thomas_factors();
   void interior_factors();
   std::vector<double> reduced_rows() const;
   void reduced_inverse();
@@ -76,8 +78,15 @@ private:
   double fc_ = -1.0, ftheta_ = -1.0;        // (c, theta) of the factors below
   // I - theta c M: off-diagonals, interior diagonal, the diagonals of my first and last row
   std::vector<double> ia_, ig_, ib_, ifirst_, ilast_;
-  std::vector<double> inv_, gp_, p_, q_; // [interior row][lane]
-  std::vector<double> rinv_;             // [2][2P][lane]: my rows of the reduced inverse
+  std::vector<double> inv_, gp_, p_, q_; // [interior row][lane] (inv_, gp_: the first nfac_)
+  PetscInt nfac_ = 0;
+  const double* inv_row(PetscInt i) const {
+    return inv_.data() + static_cast<size_t>(std::min(i, nfac_ - 1)) * static_cast<size_t>(n_);
+  }
+  const double* gp_row(PetscInt i) const {
+    return gp_.data() + static_cast<size_t>(std::min(i, nfac_ - 1)) * static_cast<size_t>(n_);
+  }
+  std::vector<double> rinv_; // [2][2P][lane]: my rows of the reduced inverse
   std::vector<double> gmine_, gall_;
 };
 
