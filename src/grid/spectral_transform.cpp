@@ -14,8 +14,9 @@ namespace morphogen {
 
 struct SpectralTransform::Plans {
   fftw_plan restF = nullptr, restB = nullptr, slowF = nullptr, slowB = nullptr;
+  fftw_plan planeF = nullptr, planeB = nullptr; // one plane of T_rest (rest_only)
   ~Plans() {
-    for (fftw_plan p : {restF, restB, slowF, slowB})
+    for (fftw_plan p : {restF, restB, slowF, slowB, planeF, planeB})
       if (p) fftw_destroy_plan(p);
   }
 };
@@ -65,6 +66,10 @@ SpectralTransform::SpectralTransform(const Grid& grid, const std::array<AxisKind
   realA_ = fftw_alloc_real(std::max<size_t>(1, nA * ncols_));
   specA_ = fftw_alloc_real(std::max<size_t>(1, nA * ncolsS_ * w_));
   specB_ = size_ == 1 || rest_only_ ? specA_ : fftw_alloc_real(std::max<size_t>(1, entries() * w_));
+  if (rest_only_) {
+    planeR_ = fftw_alloc_real(static_cast<size_t>(ncols_));
+    planeS_ = fftw_alloc_real(static_cast<size_t>(ncolsS_) * static_cast<size_t>(w_));
+  }
   fft_wisdom_load();
   plan(grid, kinds);
   if (fft_wisdom_sync(grid.comm())) { // again, from the wisdom every rank now shares
@@ -168,6 +173,8 @@ SpectralTransform::~SpectralTransform() {
   if (specB_ != specA_) fftw_free(specB_);
   fftw_free(specA_);
   fftw_free(realA_);
+  fftw_free(planeR_);
+  fftw_free(planeS_);
 }
 
 // T_rest over this rank's planes of layout A; T_slow along the strided columns of layout B.
@@ -199,6 +206,14 @@ void SpectralTransform::plan(const Grid& grid, const std::array<AxisKind, 3>& ki
                                  kf + 1, flags);
     p.restB = fftw_plan_many_r2r(nrest, rest, howA, specA_, nullptr, 1, nc, realA_, nullptr, 1, nc,
                                  kb + 1, flags);
+  }
+  if (rest_only_ && w_ == 2) {
+    auto* cS = reinterpret_cast<fftw_complex*>(planeS_);
+    p.planeF = fftw_plan_dft_r2c(nrest, rest, planeR_, cS, flags);
+    p.planeB = fftw_plan_dft_c2r(nrest, rest, cS, planeR_, flags);
+  } else if (rest_only_) {
+    p.planeF = fftw_plan_r2r(nrest, rest, planeR_, planeS_, kf + 1, flags);
+    p.planeB = fftw_plan_r2r(nrest, rest, planeS_, planeR_, kb + 1, flags);
   }
   if (rest_only_) return;
   if (nb > 0 && w_ == 2) {
@@ -288,6 +303,52 @@ void SpectralTransform::backward(Vec u) {
   run(plans_->slowB);
   if (size_ > 1 && !rest_only_) from_columns();
   rest_backward(u);
+}
+
+double* SpectralTransform::reals(Vec u, bool fetch) {
+  if (!direct_) {
+    if (fetch) {
+      MG_PETSC(VecScatterBegin(toA_, u, vA_, INSERT_VALUES, SCATTER_FORWARD));
+      MG_PETSC(VecScatterEnd(toA_, u, vA_, INSERT_VALUES, SCATTER_FORWARD));
+    }
+    return realA_;
+  }
+  PetscScalar* a = nullptr;
+  MG_PETSC(VecGetArray(u, &a));
+  return a;
+}
+
+void SpectralTransform::reals_done(Vec u, double* a, bool store) {
+  if (direct_) {
+    MG_PETSC(VecRestoreArray(u, &a));
+  } else if (store) {
+    MG_PETSC(VecScatterBegin(toA_, vA_, u, INSERT_VALUES, SCATTER_REVERSE));
+    MG_PETSC(VecScatterEnd(toA_, vA_, u, INSERT_VALUES, SCATTER_REVERSE));
+  }
+}
+
+// The plane plans were made for FFTW-aligned arrays; a plane that is not (odd plane sizes)
+// goes through the aligned scratch plane.
+void SpectralTransform::plane_forward(const double* real, double* spec) {
+  double* in = const_cast<double*>(real); // forward out-of-place plans preserve their input
+  if (fftw_alignment_of(in) != 0) in = std::copy(real, real + ncols_, planeR_) - ncols_;
+  double* out = fftw_alignment_of(spec) == 0 ? spec : planeS_;
+  if (w_ == 2)
+    fftw_execute_dft_r2c(plans_->planeF, in, reinterpret_cast<fftw_complex*>(out));
+  else
+    fftw_execute_r2r(plans_->planeF, in, out);
+  if (out != spec) std::copy(planeS_, planeS_ + ncolsS_ * w_, spec);
+}
+
+void SpectralTransform::plane_backward(double* spec, double* real) {
+  const PetscInt ns = ncolsS_ * w_;
+  double* in = fftw_alignment_of(spec) == 0 ? spec : std::copy(spec, spec + ns, planeS_) - ns;
+  double* out = fftw_alignment_of(real) == 0 ? real : planeR_;
+  if (w_ == 2)
+    fftw_execute_dft_c2r(plans_->planeB, reinterpret_cast<fftw_complex*>(in), out);
+  else
+    fftw_execute_r2r(plans_->planeB, in, out);
+  if (out != real) std::copy(planeR_, planeR_ + ncols_, real);
 }
 
 } // namespace morphogen

@@ -59,6 +59,15 @@ public:
   int width() const { return w_; }
   double norm() const { return norm_; }
 
+  // Plane by plane (rest_only, for passes fused with the slow-axis solve): layout A's reals of
+  // u (u's own array when direct, else a scattered copy: fetch fills it from u), the plane j at
+  // reals + j * plane_reals(); reals_done returns the array (store: the copy back into u).
+  double* reals(Vec u, bool fetch);
+  void reals_done(Vec u, double* a, bool store);
+  PetscInt plane_reals() const { return ncols_; }
+  void plane_forward(const double* real, double* spec); // one plane: spec = T_rest real
+  void plane_backward(double* spec, double* real);      // real = T_rest^-1 spec (spec destroyed)
+
 private:
   void plan(const Grid& grid, const std::array<AxisKind, 3>& kinds);
   void make_scatter(const Grid& grid);
@@ -80,6 +89,7 @@ private:
   std::vector<double> xbuf_; // packed blocks of the transposes
   double norm_ = 1.0;
   double *realA_ = nullptr, *specA_ = nullptr, *specB_ = nullptr;
+  double *planeR_ = nullptr, *planeS_ = nullptr; // one aligned plane each (rest_only)
   struct Plans;
   std::unique_ptr<Plans> plans_;
   VecH vA_;

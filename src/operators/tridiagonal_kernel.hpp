@@ -35,12 +35,27 @@ inline void tri_backward_row(int n, const double* gp, const double* next, double
     cur[l] -= gp[l] * next[l];
 }
 
-// The interior's answer from its particular solution y and the block's end values:
-// cur = scale (y - a F p - g E q).
-inline void tri_spike_row(int n, double scale, const double* a, const double* g, const double* F,
-                          const double* E, const double* p, const double* q, double* cur) {
+// cur *= s.
+inline void tri_scale_row(int n, double s, double* cur) {
   for (int l = 0; l < n; ++l)
-    cur[l] = scale * (cur[l] - (a[l] * F[l] * p[l] + g[l] * E[l] * q[l]));
+    cur[l] *= s;
+}
+
+// The interior's answer from its particular solution y and the block's end values:
+// cur = y - (a F p + g E q).
+inline void tri_spike_row(int n, const double* a, const double* g, const double* F, const double* E,
+                          const double* p, const double* q, double* cur) {
+  for (int l = 0; l < n; ++l)
+    cur[l] -= a[l] * F[l] * p[l] + g[l] * E[l] * q[l];
+}
+
+// One term of the block ends from the reduced inverse: F += rf gk, E += re gk.
+inline void tri_reduced_row(int n, const double* rf, const double* re, const double* gk, double* F,
+                            double* E) {
+  for (int l = 0; l < n; ++l) {
+    F[l] += rf[l] * gk[l];
+    E[l] += re[l] * gk[l];
+  }
 }
 
 } // namespace morphogen

@@ -201,6 +201,7 @@ void TridiagonalSolver::factor(double c, double theta) {
   }
   interior_factors();
   reduced_inverse();
+  truncate_spikes();
   fc_ = c;
   ftheta_ = theta;
 }
@@ -316,15 +317,96 @@ void TridiagonalSolver::reduced_inverse() {
   }
 }
 
-// spectrum <- scale G^-1 spectrum, G = I - theta c M (factored): the interior of the block by
-// Thomas, the block's ends from the reduced system, the interior corrected by the spikes.
-void TridiagonalSolver::solve(double scale) {
+// The spikes decay geometrically away from their row. The correction a F p_i of interior row i
+// is below 2^-64 |F| (F: a value of the same column's solution) once |a p_i| < 2^-64 in every
+// lane: far below the rounding of the transforms. Only the rows before that are kept (at least
+// one: the reduced system and its right-hand side use the first and the last interior row).
+void TridiagonalSolver::truncate_spikes() {
   const size_t n = static_cast<size_t>(n_);
   const PetscInt ni = m_ - 2;
-  for (PetscInt i = 0; i < ni; ++i)
-    tri_forward_row(n_, ia_.data(), inv_row(i), i > 0 ? row(i) : nullptr, row(i + 1));
-  for (PetscInt i = ni - 1; i-- > 0;)
+  const double tol = std::ldexp(1.0, -64);
+  auto reaches = [&](const std::vector<double>& v, const std::vector<double>& c, PetscInt i) {
+    for (size_t l = 0; l < n; ++l)
+      if (std::fabs(c[l] * v[static_cast<size_t>(i) * n + l]) >= tol) return true;
+    return false;
+  };
+  kp_ = std::min<PetscInt>(ni, 1);
+  for (PetscInt i = ni - 1; i >= 1; --i)
+    if (reaches(p_, ia_, i)) {
+      kp_ = i + 1;
+      break;
+    }
+  kq_ = std::min<PetscInt>(ni, 1);
+  for (PetscInt i = 0; i < ni - 1; ++i)
+    if (reaches(q_, ig_, i)) {
+      kq_ = ni - i;
+      break;
+    }
+  p_.resize(static_cast<size_t>(kp_) * n);
+  q_.erase(q_.begin(), q_.begin() + static_cast<std::ptrdiff_t>((ni - kq_) * n_));
+  p_.shrink_to_fit();
+  q_.shrink_to_fit();
+  zero_.assign(n, 0.0);
+}
+
+// x = scale (I - theta c M)^-1 (s0 + s1 M) r with scale = 1 / norm folded into s0, s1.
+void TridiagonalSolver::apply(Vec r, Vec x, double s0, double s1) {
+  const double scale = 1.0 / t_->norm();
+  double* reals = t_->reals(r, true);
+  down(reals, scale * s0, scale * s1);
+  if (x != r) {
+    t_->reals_done(r, reals, false);
+    reals = t_->reals(x, false);
+  }
+  up(reals);
+  ends(reals);
+  t_->reals_done(x, reals, true);
+}
+
+// Plane by plane: the transform, the right-hand side s0 f + s1 M f (the neighbours' edge planes
+// exchanged first), the forward elimination of the interior rows.
+void TridiagonalSolver::down(const double* reals, double s0, double s1) {
+  const PetscInt np = t_->plane_reals(), ni = m_ - 2;
+  const bool product = s1 != 0.0;
+  if (product) {
+    t_->plane_forward(reals, row(0));
+    t_->plane_forward(reals + (m_ - 1) * np, row(m_ - 1));
+    exchange_edges();
+    prev_ = lo_;
+    cur_.resize(static_cast<size_t>(n_));
+  }
+  for (PetscInt j = 0; j < m_; ++j) {
+    double* y = row(j);
+    if (product) {
+      if (j + 1 < m_ - 1) t_->plane_forward(reals + (j + 1) * np, row(j + 1));
+      std::copy(y, y + n_, cur_.begin());
+      tri_multiply_row(n_, s0, s1, a_.data(), diagonal(j), g_.data(), prev_.data(), cur_.data(),
+                       j + 1 < m_ ? row(j + 1) : hi_.data(), y);
+      std::swap(prev_, cur_);
+    } else {
+      t_->plane_forward(reals + j * np, y);
+      tri_scale_row(n_, s0, y);
+    }
+    if (j >= 1 && j <= ni)
+      tri_forward_row(n_, ia_.data(), inv_row(j - 1), j > 1 ? row(j - 1) : nullptr, y);
+  }
+}
+
+// Back substitution of the interior; an interior row the spikes do not reach is final and goes
+// back to the reals once the row above has used it.
+void TridiagonalSolver::up(double* reals) {
+  const PetscInt ni = m_ - 2;
+  for (PetscInt i = ni - 2; i >= 0; --i) {
     tri_backward_row(n_, gp_row(i), row(i + 2), row(i + 1));
+    if (!spiked(i + 1)) emit(i + 2, reals);
+  }
+}
+
+// The block's ends F, E from the reduced system (right-hand sides allgathered), the spiked
+// interior rows corrected, and all of them back to the reals.
+void TridiagonalSolver::ends(double* reals) {
+  const size_t n = static_cast<size_t>(n_);
+  const PetscInt ni = m_ - 2;
   gmine_.resize(2 * n);
   const double *f0 = row(0), *f1 = row(1), *fe = row(m_ - 1), *fe1 = row(m_ - 2);
   for (size_t l = 0; l < n; ++l) {
@@ -334,39 +416,32 @@ void TridiagonalSolver::solve(double scale) {
   const int K = 2 * size_;
   gall_.resize(static_cast<size_t>(K) * n);
   MPI_Allgather(gmine_.data(), 2 * n_, MPI_DOUBLE, gall_.data(), 2 * n_, MPI_DOUBLE, comm_);
-  std::vector<double> F(n, 0.0), E(n, 0.0);
-  for (int k = 0; k < K; ++k) {
-    const double* gk = &gall_[static_cast<size_t>(k) * n];
-    const double* rf = &rinv_[static_cast<size_t>(k) * n];
-    const double* re = &rinv_[static_cast<size_t>(K + k) * n];
-    for (size_t l = 0; l < n; ++l) {
-      F[l] += rf[l] * gk[l];
-      E[l] += re[l] * gk[l];
-    }
+  F_.assign(n, 0.0);
+  E_.assign(n, 0.0);
+  for (int k = 0; k < K; ++k)
+    tri_reduced_row(n_, &rinv_[static_cast<size_t>(k) * n], &rinv_[static_cast<size_t>(K + k) * n],
+                    &gall_[static_cast<size_t>(k) * n], F_.data(), E_.data());
+  for (PetscInt i = 0; i < ni; ++i) {
+    if (!spiked(i)) continue;
+    const double* p = i < kp_ ? &p_[static_cast<size_t>(i) * n] : zero_.data();
+    const double* q = i >= ni - kq_ ? &q_[static_cast<size_t>(i - (ni - kq_)) * n] : zero_.data();
+    tri_spike_row(n_, ia_.data(), ig_.data(), F_.data(), E_.data(), p, q, row(i + 1));
+    emit(i + 1, reals);
   }
-  for (PetscInt i = 0; i < ni; ++i)
-    tri_spike_row(n_, scale, ia_.data(), ig_.data(), F.data(), E.data(),
-                  &p_[static_cast<size_t>(i) * n], &q_[static_cast<size_t>(i) * n], row(i + 1));
-  double *x0 = row(0), *xe = row(m_ - 1);
-  for (size_t l = 0; l < n; ++l) {
-    x0[l] = scale * F[l];
-    xe[l] = scale * E[l];
-  }
+  std::copy(F_.begin(), F_.end(), row(0));
+  std::copy(E_.begin(), E_.end(), row(m_ - 1));
+  emit(0, reals);
+  emit(m_ - 1, reals);
 }
 
 void TridiagonalSolver::step(Vec u, double c, double theta) {
   factor(c, theta);
-  t_->forward(u);
-  if (theta != 1.0) multiply(1.0, (1.0 - theta) * c);
-  solve(1.0 / t_->norm());
-  t_->backward(u);
+  apply(u, u, 1.0, theta != 1.0 ? (1.0 - theta) * c : 0.0);
 }
 
 void TridiagonalSolver::solve_shifted(Vec r, Vec x, double c, double theta) {
   factor(c, theta);
-  t_->forward(r);
-  solve(1.0 / t_->norm());
-  t_->backward(x);
+  apply(r, x, 1.0, 0.0);
 }
 
 } // namespace morphogen

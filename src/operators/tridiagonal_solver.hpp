@@ -21,7 +21,11 @@
 // rank) and each rank forms its two unknowns from its two rows of the reduced inverse (LAPACK
 // dgesv at setup, once per (c, theta)); the interior follows from the spikes
 // p = A_I^-1 e_first, q = A_I^-1 e_last. The explicit half of Crank-Nicolson is the tridiagonal
-// product with the neighbouring ranks' edge planes. create() returns null and says why where it
+// product with the neighbouring ranks' edge planes. A substep is three passes over the planes
+// (transform, product and forward elimination going down; back substitution going up, the rows
+// the spikes do not reach transformed back at once; the reduced system and the rest), with
+// each plane in cache between its steps; the spikes decay geometrically and are kept only
+// where they exceed 2^-64 (truncate_spikes). create() returns null and says why where it
 // does not apply (at most kMaxRanks ranks, S >= 3 planes); the caller then uses the full
 // transform (spectral_solver.hpp) or KSP.
 #pragma once
@@ -62,7 +66,18 @@ private:
   void interior_factors();
   std::vector<double> reduced_rows() const;
   void reduced_inverse();
-  void solve(double scale); // spectrum <- scale (I - theta c M)^-1 spectrum
+  void truncate_spikes();
+  // One substep, x = scale (I - theta c M)^-1 (s0 + s1 M) r (s1 = 0: no product), in three passes
+  // over the planes: down (transform, product, forward elimination), up (back substitution; the
+  // rows the spikes do not reach go back to x at once), ends (reduced system, the other rows).
+  void apply(Vec r, Vec x, double s0, double s1);
+  void down(const double* reals, double s0, double s1);
+  void up(double* reals);
+  void ends(double* reals);
+  bool spiked(PetscInt i) const { return i < kp_ || i >= m_ - 2 - kq_; } // interior row i
+  void emit(PetscInt j, double* reals) {
+    t_->plane_backward(row(j), reals + j * t_->plane_reals());
+  }
   double* row(PetscInt j) { return t_->spectrum() + j * n_; }
   const double* diagonal(PetscInt j) const; // M's diagonal of my row j
 
@@ -78,8 +93,13 @@ private:
   double fc_ = -1.0, ftheta_ = -1.0;        // (c, theta) of the factors below
   // I - theta c M: off-diagonals, interior diagonal, the diagonals of my first and last row
   std::vector<double> ia_, ig_, ib_, ifirst_, ilast_;
-  std::vector<double> inv_, gp_, p_, q_; // [interior row][lane] (inv_, gp_: the first nfac_)
+  std::vector<double> inv_, gp_; // [interior row][lane]: the first nfac_ rows
   PetscInt nfac_ = 0;
+  // The spikes' rows that matter: p_ the first kp_ interior rows, q_ the last kq_ (beyond them
+  // |a p|, |g q| < 2^-64 in every lane; see truncate_spikes).
+  std::vector<double> p_, q_;
+  PetscInt kp_ = 0, kq_ = 0;
+  std::vector<double> prev_, cur_, zero_, F_, E_; // one row each
   const double* inv_row(PetscInt i) const {
     return inv_.data() + static_cast<size_t>(std::min(i, nfac_ - 1)) * static_cast<size_t>(n_);
   }
