@@ -57,6 +57,7 @@ SpectralTransform::SpectralTransform(const Grid& grid, const std::array<AxisKind
   }
   w_ = all_periodic ? 2 : 1;
   S_ = g.n[dim - 1];
+  nx_ = g.n[0];
   ncols_ = grid.global_cells() / S_;
   ncolsS_ = all_periodic ? ncols_ / g.n[0] * (g.n[0] / 2 + 1) : ncols_;
   comm_ = grid.comm();
@@ -305,21 +306,22 @@ void SpectralTransform::backward(Vec u) {
   rest_backward(u);
 }
 
-double* SpectralTransform::reals(Vec u, bool fetch) {
+PlaneView SpectralTransform::reals(Vec u, bool fetch) {
+  PlaneView v{realA_, ncols_, nx_, ncols_ / nx_, nx_};
   if (!direct_) {
     if (fetch) {
       MG_PETSC(VecScatterBegin(toA_, u, vA_, INSERT_VALUES, SCATTER_FORWARD));
       MG_PETSC(VecScatterEnd(toA_, u, vA_, INSERT_VALUES, SCATTER_FORWARD));
     }
-    return realA_;
+    return v;
   }
-  PetscScalar* a = nullptr;
-  MG_PETSC(VecGetArray(u, &a));
-  return a;
+  MG_PETSC(VecGetArray(u, &v.base));
+  return v;
 }
 
-void SpectralTransform::reals_done(Vec u, double* a, bool store) {
+void SpectralTransform::reals_done(Vec u, const PlaneView& v, bool store) {
   if (direct_) {
+    PetscScalar* a = v.base;
     MG_PETSC(VecRestoreArray(u, &a));
   } else if (store) {
     MG_PETSC(VecScatterBegin(toA_, vA_, u, INSERT_VALUES, SCATTER_REVERSE));
@@ -327,11 +329,16 @@ void SpectralTransform::reals_done(Vec u, double* a, bool store) {
   }
 }
 
-// The plane plans were made for FFTW-aligned arrays; a plane that is not (odd plane sizes)
-// goes through the aligned scratch plane.
-void SpectralTransform::plane_forward(const double* real, double* spec) {
-  double* in = const_cast<double*>(real); // forward out-of-place plans preserve their input
-  if (fftw_alignment_of(in) != 0) in = std::copy(real, real + ncols_, planeR_) - ncols_;
+// The plane plans were made for contiguous FFTW-aligned planes; any other plane (odd sizes,
+// rows with ghosts between them) goes through the scratch plane.
+void SpectralTransform::plane_forward(const PlaneView& v, PetscInt j, double* spec) {
+  const double* p = v.base + j * v.plane;
+  double* in = const_cast<double*>(p); // forward out-of-place plans preserve their input
+  if (!((v.rows == 1 || v.row == v.len) && fftw_alignment_of(in) == 0)) {
+    for (PetscInt r = 0; r < v.rows; ++r)
+      std::copy(p + r * v.row, p + r * v.row + v.len, planeR_ + r * v.len);
+    in = planeR_;
+  }
   double* out = fftw_alignment_of(spec) == 0 ? spec : planeS_;
   if (w_ == 2)
     fftw_execute_dft_r2c(plans_->planeF, in, reinterpret_cast<fftw_complex*>(out));
@@ -340,15 +347,19 @@ void SpectralTransform::plane_forward(const double* real, double* spec) {
   if (out != spec) std::copy(planeS_, planeS_ + ncolsS_ * w_, spec);
 }
 
-void SpectralTransform::plane_backward(double* spec, double* real) {
+void SpectralTransform::plane_backward(double* spec, const PlaneView& v, PetscInt j) {
   const PetscInt ns = ncolsS_ * w_;
+  double* p = v.base + j * v.plane;
   double* in = fftw_alignment_of(spec) == 0 ? spec : std::copy(spec, spec + ns, planeS_) - ns;
-  double* out = fftw_alignment_of(real) == 0 ? real : planeR_;
+  const bool direct = (v.rows == 1 || v.row == v.len) && fftw_alignment_of(p) == 0;
+  double* out = direct ? p : planeR_;
   if (w_ == 2)
     fftw_execute_dft_c2r(plans_->planeB, reinterpret_cast<fftw_complex*>(in), out);
   else
     fftw_execute_r2r(plans_->planeB, in, out);
-  if (out != real) std::copy(planeR_, planeR_ + ncols_, real);
+  if (!direct)
+    for (PetscInt r = 0; r < v.rows; ++r)
+      std::copy(planeR_ + r * v.len, planeR_ + (r + 1) * v.len, p + r * v.row);
 }
 
 } // namespace morphogen

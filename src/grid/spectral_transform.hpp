@@ -26,12 +26,21 @@
 #include "grid/grid.hpp"
 
 #include <array>
+#include <cstddef>
 #include <memory>
 #include <vector>
 
 namespace morphogen {
 
 enum class AxisKind { Periodic, Even, Odd };
+
+// Where the planes of layout A lie in an array: row r (of `rows` rows of `len` reals) of plane j
+// (from first_plane()) at base + j * plane + r * row.
+struct PlaneView {
+  double* base = nullptr;
+  std::ptrdiff_t plane = 0, row = 0;
+  PetscInt rows = 1, len = 0;
+};
 
 // The kinds of the grid's boundaries: periodic, Neumann -> even, Dirichlet -> odd.
 std::array<AxisKind, 3> axis_kinds(const Grid& grid);
@@ -60,13 +69,14 @@ public:
   double norm() const { return norm_; }
 
   // Plane by plane (rest_only, for passes fused with the slow-axis solve): layout A's reals of
-  // u (u's own array when direct, else a scattered copy: fetch fills it from u), the plane j at
-  // reals + j * plane_reals(); reals_done returns the array (store: the copy back into u).
-  double* reals(Vec u, bool fetch);
-  void reals_done(Vec u, double* a, bool store);
-  PetscInt plane_reals() const { return ncols_; }
-  void plane_forward(const double* real, double* spec); // one plane: spec = T_rest real
-  void plane_backward(double* spec, double* real);      // real = T_rest^-1 spec (spec destroyed)
+  // the global vector u (u's own array when direct, else a scattered copy: fetch fills it from
+  // u); reals_done returns the array (store: the copy back into u). direct(): layout A is the
+  // DMDA's own decomposition (so a ghosted local vector's owned planes are layout A too).
+  PlaneView reals(Vec u, bool fetch);
+  void reals_done(Vec u, const PlaneView& v, bool store);
+  bool direct() const { return direct_; }
+  void plane_forward(const PlaneView& v, PetscInt j, double* spec);  // spec = T_rest (plane j)
+  void plane_backward(double* spec, const PlaneView& v, PetscInt j); // spec destroyed
 
 private:
   void plan(const Grid& grid, const std::array<AxisKind, 3>& kinds);
@@ -79,6 +89,7 @@ private:
   void rest_forward(Vec u);
   void rest_backward(Vec u);
   PetscInt S_ = 1, ncols_ = 1, ncolsS_ = 1;    // slow-axis cells, rest cells, rest spectral columns
+  PetscInt nx_ = 1;                            // cells along x (a row of a plane)
   PetscInt a0_ = 0, a1_ = 0, b0_ = 0, nb_ = 0; // my slow planes [a0, a1), columns [b0, b0 + nb)
   int w_ = 1, size_ = 1, rank_ = 0;
   bool rest_only_ = false;

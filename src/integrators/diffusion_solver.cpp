@@ -196,6 +196,16 @@ void DiffusionSolver::prepare(double dt, double theta) {
     if (!spectral_[s]) prepare_species(s, dt, theta); // (on demand if the FFT solve is dropped)
 }
 
+bool DiffusionSolver::solve_local(int s, Vec ulocal, double dt, double theta) {
+  if (ops_.scale(s) == 0.0 || ops_.has_dirichlet() || !use_spectral(s) ||
+      !spectral_[s]->steps_local())
+    return false;
+  LogScope log_scope(log_events().diffusion);
+  spectral_[s]->step_local(ulocal, dt * ops_.scale(s), theta);
+  iterations_[s] = 0;
+  return true;
+}
+
 void DiffusionSolver::solve(int s, Vec u, double dt, double theta, PetscInt step) {
   LogScope log_scope(log_events().diffusion);
   if (ops_.scale(s) == 0.0) {

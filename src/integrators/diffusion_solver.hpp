@@ -55,6 +55,10 @@ public:
   void prepare(double dt, double theta);
   // Solve for species s in place on the global Vec u. `step` is for messages.
   void solve(int s, Vec u, double dt, double theta, PetscInt step);
+  // The same on the owned cells of a ghosted local vector, where species s's exact solve works
+  // on it in place (no Dirichlet data); false (nothing done) elsewhere: then copy to a global
+  // vector and call solve.
+  bool solve_local(int s, Vec ulocal, double dt, double theta);
 
   // Species s's matrix was re-assembled (solution-dependent coefficients, lagged per step):
   // A_s is rebuilt on the next solve.

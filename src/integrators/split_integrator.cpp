@@ -95,10 +95,12 @@ void SplitIntegrator::react(std::vector<VecH>& u, double t0, double dt, PetscInt
 }
 
 void SplitIntegrator::diffuse(std::vector<VecH>& u, double dt, PetscInt step) {
-  // Owned cells move between the ghosted local state and the solver's global vector row by
-  // row (the solve needs no ghosts; DMLocalToGlobal does not support every periodic layout).
+  // In place where the exact solve reads and writes the ghosted local state itself; otherwise
+  // owned cells move between it and the solver's global vector row by row (the solve needs no
+  // ghosts; DMLocalToGlobal does not support every periodic layout).
   const Box& ob = grid_.owned();
   for (size_t s = 0; s < u.size(); ++s) {
+    if (diffusion_.solve_local(static_cast<int>(s), u[s], dt, set_.theta)) continue;
     for (int dir = 0; dir < 2; ++dir) {
       PetscScalar *l, *g;
       MG_PETSC(VecGetArray(u[s], &l));

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <petscvec.h>
+#include <stdexcept>
 #include <string>
 
 namespace morphogen {
@@ -16,6 +17,13 @@ public:
   virtual ~ExactSolve() = default;
   virtual void step(Vec u, double c, double theta) = 0;
   virtual void solve_shifted(Vec r, Vec x, double c, double theta) = 0;
+  // step on the owned cells of a ghosted local vector (ghosts untouched), where the method can
+  // read and write it in place (steps_local()); elsewhere the caller copies the owned cells to
+  // a global vector and calls step.
+  virtual bool steps_local() const { return false; }
+  virtual void step_local(Vec /*ulocal*/, double /*c*/, double /*theta*/) {
+    throw std::logic_error("ExactSolve::step_local: not offered by " + method());
+  }
   // For the setup log, e.g. "spectral (FFT/DCT, exact)".
   virtual std::string method() const = 0;
 };

@@ -352,25 +352,25 @@ void TridiagonalSolver::truncate_spikes() {
 // x = scale (I - theta c M)^-1 (s0 + s1 M) r with scale = 1 / norm folded into s0, s1.
 void TridiagonalSolver::apply(Vec r, Vec x, double s0, double s1) {
   const double scale = 1.0 / t_->norm();
-  double* reals = t_->reals(r, true);
-  down(reals, scale * s0, scale * s1);
+  PlaneView v = t_->reals(r, true);
+  down(v, scale * s0, scale * s1);
   if (x != r) {
-    t_->reals_done(r, reals, false);
-    reals = t_->reals(x, false);
+    t_->reals_done(r, v, false);
+    v = t_->reals(x, false);
   }
-  up(reals);
-  ends(reals);
-  t_->reals_done(x, reals, true);
+  up(v);
+  ends(v);
+  t_->reals_done(x, v, true);
 }
 
 // Plane by plane: the transform, the right-hand side s0 f + s1 M f (the neighbours' edge planes
 // exchanged first), the forward elimination of the interior rows.
-void TridiagonalSolver::down(const double* reals, double s0, double s1) {
-  const PetscInt np = t_->plane_reals(), ni = m_ - 2;
+void TridiagonalSolver::down(const PlaneView& in, double s0, double s1) {
+  const PetscInt ni = m_ - 2;
   const bool product = s1 != 0.0;
   if (product) {
-    t_->plane_forward(reals, row(0));
-    t_->plane_forward(reals + (m_ - 1) * np, row(m_ - 1));
+    t_->plane_forward(in, 0, row(0));
+    t_->plane_forward(in, m_ - 1, row(m_ - 1));
     exchange_edges();
     prev_ = lo_;
     cur_.resize(static_cast<size_t>(n_));
@@ -378,13 +378,13 @@ void TridiagonalSolver::down(const double* reals, double s0, double s1) {
   for (PetscInt j = 0; j < m_; ++j) {
     double* y = row(j);
     if (product) {
-      if (j + 1 < m_ - 1) t_->plane_forward(reals + (j + 1) * np, row(j + 1));
+      if (j + 1 < m_ - 1) t_->plane_forward(in, j + 1, row(j + 1));
       std::copy(y, y + n_, cur_.begin());
       tri_multiply_row(n_, s0, s1, a_.data(), diagonal(j), g_.data(), prev_.data(), cur_.data(),
                        j + 1 < m_ ? row(j + 1) : hi_.data(), y);
       std::swap(prev_, cur_);
     } else {
-      t_->plane_forward(reals + j * np, y);
+      t_->plane_forward(in, j, y);
       tri_scale_row(n_, s0, y);
     }
     if (j >= 1 && j <= ni)
@@ -394,17 +394,17 @@ void TridiagonalSolver::down(const double* reals, double s0, double s1) {
 
 // Back substitution of the interior; an interior row the spikes do not reach is final and goes
 // back to the reals once the row above has used it.
-void TridiagonalSolver::up(double* reals) {
+void TridiagonalSolver::up(const PlaneView& out) {
   const PetscInt ni = m_ - 2;
   for (PetscInt i = ni - 2; i >= 0; --i) {
     tri_backward_row(n_, gp_row(i), row(i + 2), row(i + 1));
-    if (!spiked(i + 1)) emit(i + 2, reals);
+    if (!spiked(i + 1)) emit(i + 2, out);
   }
 }
 
 // The block's ends F, E from the reduced system (right-hand sides allgathered), the spiked
 // interior rows corrected, and all of them back to the reals.
-void TridiagonalSolver::ends(double* reals) {
+void TridiagonalSolver::ends(const PlaneView& out) {
   const size_t n = static_cast<size_t>(n_);
   const PetscInt ni = m_ - 2;
   gmine_.resize(2 * n);
@@ -426,17 +426,39 @@ void TridiagonalSolver::ends(double* reals) {
     const double* p = i < kp_ ? &p_[static_cast<size_t>(i) * n] : zero_.data();
     const double* q = i >= ni - kq_ ? &q_[static_cast<size_t>(i - (ni - kq_)) * n] : zero_.data();
     tri_spike_row(n_, ia_.data(), ig_.data(), F_.data(), E_.data(), p, q, row(i + 1));
-    emit(i + 1, reals);
+    emit(i + 1, out);
   }
   std::copy(F_.begin(), F_.end(), row(0));
   std::copy(E_.begin(), E_.end(), row(m_ - 1));
-  emit(0, reals);
-  emit(m_ - 1, reals);
+  emit(0, out);
+  emit(m_ - 1, out);
 }
 
 void TridiagonalSolver::step(Vec u, double c, double theta) {
   factor(c, theta);
   apply(u, u, 1.0, theta != 1.0 ? (1.0 - theta) * c : 0.0);
+}
+
+// The owned planes of a ghosted local vector are layout A when the DMDA is split in slabs.
+void TridiagonalSolver::step_local(Vec ulocal, double c, double theta) {
+  if (!t_->direct()) throw std::logic_error("TridiagonalSolver::step_local: not slabs");
+  factor(c, theta);
+  const Box& gb = grid_.ghosted();
+  const bool three = grid_.dim() == 3;
+  PlaneView v;
+  MG_PETSC(VecGetArray(ulocal, &v.base));
+  double* const a = v.base;
+  v.base += three ? grid_.local_index(0, 0, a0_) : grid_.local_index(0, a0_, 0);
+  v.row = gb.m[0];
+  v.plane = three ? gb.m[0] * gb.m[1] : gb.m[0];
+  v.rows = three ? grid_.spec().n[1] : 1;
+  v.len = grid_.spec().n[0];
+  const double scale = 1.0 / t_->norm();
+  down(v, scale, theta != 1.0 ? scale * (1.0 - theta) * c : 0.0);
+  up(v);
+  ends(v);
+  double* b = a;
+  MG_PETSC(VecRestoreArray(ulocal, &b));
 }
 
 void TridiagonalSolver::solve_shifted(Vec r, Vec x, double c, double theta) {

@@ -51,6 +51,8 @@ public:
 
   void step(Vec u, double c, double theta) override;
   void solve_shifted(Vec r, Vec x, double c, double theta) override;
+  bool steps_local() const override { return t_->direct(); }
+  void step_local(Vec ulocal, double c, double theta) override;
   std::string method() const override;
 
 private:
@@ -71,13 +73,11 @@ private:
   // over the planes: down (transform, product, forward elimination), up (back substitution; the
   // rows the spikes do not reach go back to x at once), ends (reduced system, the other rows).
   void apply(Vec r, Vec x, double s0, double s1);
-  void down(const double* reals, double s0, double s1);
-  void up(double* reals);
-  void ends(double* reals);
+  void down(const PlaneView& in, double s0, double s1);
+  void up(const PlaneView& out);
+  void ends(const PlaneView& out);
   bool spiked(PetscInt i) const { return i < kp_ || i >= m_ - 2 - kq_; } // interior row i
-  void emit(PetscInt j, double* reals) {
-    t_->plane_backward(row(j), reals + j * t_->plane_reals());
-  }
+  void emit(PetscInt j, const PlaneView& out) { t_->plane_backward(row(j), out, j); }
   double* row(PetscInt j) { return t_->spectrum() + j * n_; }
   const double* diagonal(PetscInt j) const; // M's diagonal of my row j
 
