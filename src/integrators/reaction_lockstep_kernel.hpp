@@ -7,7 +7,7 @@
 // started from the better of u and the explicit Euler predictor, full Newton steps
 //   (I - c dt dR/du(v)) dv = -F(v),  v <- v + dv,
 // converged by reaction_kernel.hpp's test (||dv||_inf <= tol (1 + max(||u||_inf, ||v||_inf)) or
-// the contraction estimate from the previous update, newton_converged_mask), but solved for W = 16
+// the contraction estimate from the previous update, newton_converged_mask), but solved for W = 64
 // cells of a row at once, held as structure-of-arrays (one array per species/state over the lanes):
 // the start and each Newton step is one loop over the lanes with no branches - 0/1 masks held
 // as doubles, selects, no early exit per lane - so GCC vectorises it (-fopt-info-vec reports
@@ -183,21 +183,22 @@ MG_LANES_WIDE inline void lockstep_newton(LockstepLanes<NS, NP, W>& L, double cd
   }
 }
 
-// Lanes still iterating (neither converged nor handed to the per-cell solver).
+// Lanes still iterating (neither converged nor handed to the per-cell solver). (Integer
+// reductions: they vectorise, where a floating-point sum or product would be a serial chain.)
 template <int NS, int NP, int W>
 inline bool lockstep_any_active(const LockstepLanes<NS, NP, W>& L) {
-  double busy = 0.0;
+  int busy = 0;
   for (int l = 0; l < W; ++l)
-    busy += (1.0 - L.done[l]) * (1.0 - L.bad[l]);
-  return busy != 0.0;
+    busy |= static_cast<int>(L.done[l] == 0.0) & static_cast<int>(L.bad[l] == 0.0);
+  return busy != 0;
 }
 
-// 1.0 when every lane converged in the lockstep (no lane needs the per-cell solver).
+// Every lane converged in the lockstep (no lane needs the per-cell solver).
 template <int NS, int NP, int W> inline bool lockstep_all_done(const LockstepLanes<NS, NP, W>& L) {
-  double d = 1.0;
+  int all = 1;
   for (int l = 0; l < W; ++l)
-    d *= L.done[l];
-  return d != 0.0;
+    all &= static_cast<int>(L.done[l] != 0.0);
+  return all != 0;
 }
 
 // A full, converged chunk: clamped outputs, per-lane running maxima of iterations and residual.
@@ -219,6 +220,75 @@ inline void lockstep_store(const LockstepLanes<NS, NP, W>& L, int i0, const doub
   }
 }
 
+// The implicit row (2-3 species, maxit >= 1): chunks of kLockstepLanes cells. 32 lanes keep
+// enough independent vectors in flight that a Newton step's dependency chain (Jacobian, the
+// division of Cramer's rule, rates, masks) does not set the pace; a lane's arithmetic does
+// not depend on the chunk width.
+constexpr int kLockstepLanes = 64;
+
+template <class M, bool FieldParams>
+MG_LANES_WIDE inline int
+lockstep_implicit_row(ReactionScheme scheme, int n, const double* const* u,
+                      const double* const* prow, const double* pconst, const double* const* S0,
+                      const double* const* S1, double dt, double tol, int maxit,
+                      const double* floor, double* const* out, CellSolve* worst) {
+  constexpr int NS = M::nspecies;
+  constexpr int NP = M::nparams > 0 ? M::nparams : 1;
+  constexpr int W = kLockstepLanes;
+  const bool trap = scheme == ReactionScheme::Trapezoidal;
+  const double cdt = trap ? 0.5 * dt : dt;
+  const double big = std::sqrt(tol);
+  CellSolve acc{0, 0.0, true};
+  double its_max[W] = {}, res_max[W] = {};
+  LockstepLanes<NS, NP, W> L;
+  for (int i0 = 0; i0 < n; i0 += W) {
+    const int w = n - i0 < W ? n - i0 : W;
+    lockstep_load<NS, NP, W, FieldParams>(L, i0, w, M::nparams, u, prow, pconst, S0, S1);
+    lockstep_start<M>(L, trap ? 1.0 : 0.0, cdt);
+    for (int it = 1; it <= maxit && lockstep_any_active(L); ++it)
+      lockstep_newton<M>(L, cdt, tol, big, static_cast<double>(it));
+    if (w == W && lockstep_all_done(L)) {
+      lockstep_store(L, i0, floor, out, its_max, res_max);
+      continue;
+    }
+    for (int l = 0; l < w; ++l) {
+      double v[NS];
+      CellSolve cs{static_cast<int>(L.its[l]), L.res[l], true};
+#pragma GCC unroll 16
+      for (int s = 0; s < NS; ++s)
+        v[s] = L.v[s][l];
+      if (L.done[l] == 0.0) { // the per-cell solver: damping, or its failure report
+        double uc[NS], a[NS], b[NS], pc[NP];
+#pragma GCC unroll 16
+        for (int s = 0; s < NS; ++s) {
+          uc[s] = L.u[s][l];
+          a[s] = L.s0[s][l];
+          b[s] = L.s1[s][l];
+        }
+#pragma GCC unroll 16
+        for (int q = 0; q < NP; ++q)
+          pc[q] = L.p[q][l];
+        cs = reaction_cell_of<NS>(M{}, scheme, uc, pc, a, b, dt, tol, maxit, v);
+        if (!cs.converged) {
+          if (worst) *worst = cs;
+          return i0 + l;
+        }
+      }
+      if (cs.iterations > acc.iterations) acc.iterations = cs.iterations;
+      if (cs.residual > acc.residual) acc.residual = cs.residual;
+#pragma GCC unroll 16
+      for (int s = 0; s < NS; ++s)
+        out[s][i0 + l] = clamp_to_floor(v[s], floor[s]);
+    }
+  }
+  for (int l = 0; l < W; ++l) {
+    if (its_max[l] > acc.iterations) acc.iterations = static_cast<int>(its_max[l]);
+    if (res_max[l] > acc.residual) acc.residual = res_max[l];
+  }
+  if (worst) *worst = acc;
+  return -1;
+}
+
 } // namespace detail
 
 template <class M, bool FieldParams>
@@ -228,8 +298,6 @@ inline int reaction_row_lockstep(ReactionScheme scheme, int n, const double* con
                                  double tol, int maxit, const double* floor, double* const* out,
                                  CellSolve* worst) {
   constexpr int NS = M::nspecies;
-  constexpr int NP = M::nparams > 0 ? M::nparams : 1;
-  constexpr int W = 16;
   const bool implicit =
       scheme == ReactionScheme::BackwardEuler || scheme == ReactionScheme::Trapezoidal;
   if (scheme == ReactionScheme::Euler || scheme == ReactionScheme::Heun ||
@@ -242,60 +310,9 @@ inline int reaction_row_lockstep(ReactionScheme scheme, int n, const double* con
   else if (!implicit || maxit < 1)
     return reaction_row<M, FieldParams>(scheme, n, u, prow, pconst, S0, S1, dt, tol, maxit, floor,
                                         out, worst);
-  else {
-    const bool trap = scheme == ReactionScheme::Trapezoidal;
-    const double cdt = trap ? 0.5 * dt : dt;
-    const double big = std::sqrt(tol);
-    CellSolve acc{0, 0.0, true};
-    double its_max[W] = {}, res_max[W] = {};
-    detail::LockstepLanes<NS, NP, W> L;
-    for (int i0 = 0; i0 < n; i0 += W) {
-      const int w = n - i0 < W ? n - i0 : W;
-      detail::lockstep_load<NS, NP, W, FieldParams>(L, i0, w, M::nparams, u, prow, pconst, S0, S1);
-      detail::lockstep_start<M>(L, trap ? 1.0 : 0.0, cdt);
-      for (int it = 1; it <= maxit && detail::lockstep_any_active(L); ++it)
-        detail::lockstep_newton<M>(L, cdt, tol, big, static_cast<double>(it));
-      if (w == W && detail::lockstep_all_done(L)) {
-        detail::lockstep_store(L, i0, floor, out, its_max, res_max);
-        continue;
-      }
-      for (int l = 0; l < w; ++l) {
-        double v[NS];
-        CellSolve cs{static_cast<int>(L.its[l]), L.res[l], true};
-#pragma GCC unroll 16
-        for (int s = 0; s < NS; ++s)
-          v[s] = L.v[s][l];
-        if (L.done[l] == 0.0) { // the per-cell solver: damping, or its failure report
-          double uc[NS], a[NS], b[NS], pc[NP];
-#pragma GCC unroll 16
-          for (int s = 0; s < NS; ++s) {
-            uc[s] = L.u[s][l];
-            a[s] = L.s0[s][l];
-            b[s] = L.s1[s][l];
-          }
-#pragma GCC unroll 16
-          for (int q = 0; q < NP; ++q)
-            pc[q] = L.p[q][l];
-          cs = reaction_cell_of<NS>(M{}, scheme, uc, pc, a, b, dt, tol, maxit, v);
-          if (!cs.converged) {
-            if (worst) *worst = cs;
-            return i0 + l;
-          }
-        }
-        if (cs.iterations > acc.iterations) acc.iterations = cs.iterations;
-        if (cs.residual > acc.residual) acc.residual = cs.residual;
-#pragma GCC unroll 16
-        for (int s = 0; s < NS; ++s)
-          out[s][i0 + l] = clamp_to_floor(v[s], floor[s]);
-      }
-    }
-    for (int l = 0; l < W; ++l) {
-      if (its_max[l] > acc.iterations) acc.iterations = static_cast<int>(its_max[l]);
-      if (res_max[l] > acc.residual) acc.residual = res_max[l];
-    }
-    if (worst) *worst = acc;
-    return -1;
-  }
+  else
+    return detail::lockstep_implicit_row<M, FieldParams>(scheme, n, u, prow, pconst, S0, S1, dt,
+                                                         tol, maxit, floor, out, worst);
 }
 
 } // namespace morphogen
