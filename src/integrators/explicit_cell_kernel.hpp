@@ -1,6 +1,7 @@
 // One cell of the fused explicit Euler update: the per-cell form of explicit_row
 // (integrators/explicit_kernel.hpp) for the CUDA path, with the same operations in the same
-// order. For each species s, with the stencil in row form (grid/stencil.hpp, RowStencil):
+// order (the same fused multiply-adds: fma here, std::fma there). For each species s, with the
+// stencil in row form (grid/stencil.hpp, RowStencil):
 //   lap_s = sum_r ( w[r][0] u_s(x-1, r) + w[r][1] u_s(x, r) + w[r][2] u_s(x+1, r) )
 //   out_s = max( u_s + dt (D_s lap_s + R_s(u; p)),  floor_s )
 // u[s] is species s's ghosted array and c the cell's index in it; stencil row r starts at
@@ -10,6 +11,8 @@
 
 #include "fields/clamp_kernel.hpp"
 #include "models/model.hpp"
+
+#include <math.h>
 
 namespace morphogen {
 
@@ -36,15 +39,15 @@ MG_HD inline void explicit_cell(const double* const* u, long c, const CellStenci
   M::rates(uc, k.p, r);
   for (int s = 0; s < NS; ++s) {
     const double* us = u[s] + c;
-    double lap = st.w[0][0] * us[-1] + st.w[0][1] * uc[s] + st.w[0][2] * us[1];
+    double lap = fma(st.w[0][2], us[1], fma(st.w[0][1], uc[s], st.w[0][0] * us[-1]));
     for (int q = 1; q < NR; ++q) {
       const double* row = us + st.roff[q];
       if constexpr (Box)
-        lap += st.w[q][0] * row[-1] + st.w[q][1] * row[0] + st.w[q][2] * row[1];
+        lap = fma(st.w[q][2], row[1], fma(st.w[q][1], row[0], fma(st.w[q][0], row[-1], lap)));
       else
-        lap += st.w[q][1] * row[0];
+        lap = fma(st.w[q][1], row[0], lap);
     }
-    const double v = uc[s] + k.dt * (k.D[s] * lap + r[s]);
+    const double v = fma(k.dt, fma(k.D[s], lap, r[s]), uc[s]);
     out[s][o] = clamp_to_floor(v, k.floor[s]);
   }
 }

@@ -5,6 +5,10 @@
 // For each cell i of the row and each species s:
 //   lap_s = sum_r ( w[r][0] u_s,r[i-1] + w[r][1] u_s,r[i] + w[r][2] u_s,r[i+1] )
 //   out_s = max( u_s + dt (D_s lap_s + R_s(u; p)),  floor_s )
+// evaluated as a fixed chain of fused multiply-adds (std::fma, left to right over the taps;
+// out = fma(dt, fma(D, lap, R), u)), the same for every cell wherever it lies in a row: the
+// project is compiled without FMA contraction (CMakeLists.txt), which could otherwise pair the
+// operations differently in a loop's vector body and its remainder.
 // Star stencils (5pt, 7pt: Box = false) use only the centre tap of rows r > 0; box stencils
 // (9pt) use all three. One pointer per (species, row) keeps the live registers low (the x
 // neighbours are the same pointer at i -+ 1). floor_s is 0 when negative concentrations are
@@ -21,6 +25,8 @@
 #pragma once
 
 #include "fields/clamp_kernel.hpp"
+
+#include <cmath>
 
 namespace morphogen {
 
@@ -51,6 +57,7 @@ struct ExplicitRow {
 //   C = (k1 + k2) + (k3 + k4)        (the 4 corner rows)
 //   q(x) = (w_c A + w_f B) + w_e C   (the taps at dx = 0)
 //   p(x) = (w_f A + w_e B) + w_k C   (the taps at dx = -1, +1; w_k C left out if !Corners)
+// (each sum of products a chain of std::fma from the left)
 template <bool Corners>
 inline void box_row_profiles(const double* const* rows, const double* w, int x0, int len,
                              double* __restrict__ p, double* __restrict__ q) {
@@ -69,11 +76,11 @@ inline void box_row_profiles(const double* const* rows, const double* w, int x0,
     const double A = c0[x];
     const double B = (f1[x] + f2[x]) + (f3[x] + f4[x]);
     const double C = (k1[x] + k2[x]) + (k3[x] + k4[x]);
-    q[x] = (wc * A + wf * B) + we * C;
+    q[x] = std::fma(we, C, std::fma(wf, B, wc * A));
     if constexpr (Corners)
-      p[x] = (wf * A + we * B) + wk * C;
+      p[x] = std::fma(wk, C, std::fma(we, B, wf * A));
     else
-      p[x] = wf * A + we * B;
+      p[x] = std::fma(we, B, wf * A);
   }
 }
 
@@ -130,7 +137,7 @@ inline void explicit_row_box_classes(const ExplicitRow& a) {
       M::rates(u, p, r);
       for (int s = 0; s < NS; ++s) {
         const double lap = qbuf[s][x + 1] + (pbuf[s][x] + pbuf[s][x + 2]);
-        const double v = u[s] + dt * (D[s] * lap + r[s]);
+        const double v = std::fma(dt, std::fma(D[s], lap, r[s]), u[s]);
         dst[s][i] = clamp_to_floor(v, floor[s]);
       }
     }
@@ -188,15 +195,16 @@ inline void explicit_row(const ExplicitRow& a) {
       M::rates(u, p, r);
       for (int s = 0; s < NS; ++s) {
         const double* __restrict__ c = src[s * NR];
-        double lap = w[0][0] * c[i - 1] + w[0][1] * u[s] + w[0][2] * c[i + 1];
+        double lap = std::fma(w[0][2], c[i + 1], std::fma(w[0][1], u[s], w[0][0] * c[i - 1]));
         for (int q = 1; q < NR; ++q) {
           const double* __restrict__ row = src[s * NR + q];
           if constexpr (Box)
-            lap += w[q][0] * row[i - 1] + w[q][1] * row[i] + w[q][2] * row[i + 1];
+            lap = std::fma(w[q][2], row[i + 1],
+                           std::fma(w[q][1], row[i], std::fma(w[q][0], row[i - 1], lap)));
           else
-            lap += w[q][1] * row[i];
+            lap = std::fma(w[q][1], row[i], lap);
         }
-        const double v = u[s] + dt * (D[s] * lap + r[s]);
+        const double v = std::fma(dt, std::fma(D[s], lap, r[s]), u[s]);
         dst[s][i] = clamp_to_floor(v, floor[s]);
       }
     }
@@ -248,7 +256,7 @@ inline void explicit_row_pre_of(const Model& m, int np, const ExplicitRow& a) {
       u[s] = src[s][i];
     m.rates(u, p, r);
     for (int s = 0; s < NS; ++s) {
-      const double v = u[s] + dt * (div[s][i] + r[s]);
+      const double v = std::fma(dt, div[s][i] + r[s], u[s]);
       dst[s][i] = clamp_to_floor(v, floor[s]);
     }
   }
@@ -268,7 +276,7 @@ template <int NS> inline void explicit_row_pre_rates(const ExplicitRow& a, const
     const double floor = a.floor[s];
 #pragma GCC ivdep
     for (int i = 0; i < n; ++i) {
-      const double v = u[i] + dt * (div[i] + rs[i]);
+      const double v = std::fma(dt, div[i] + rs[i], u[i]);
       dst[i] = clamp_to_floor(v, floor);
     }
   }

@@ -2,8 +2,9 @@
 // stencil row layout and for scalar or per-cell parameters, the general explicit path's update
 // (diffusion precomputed) and the split integrator's per-cell reaction substep (the lockstep
 // Newton of reaction_lockstep_kernel.hpp). Each model's
-// table is instantiated in its own translation unit (integrators/kernels/<model>.cpp, declared
-// `extern template` here), so adding a kernel variant does not grow one file's compile time.
+// explicit and reaction rows are instantiated in their own translation units
+// (integrators/kernels/<model>.cpp and <model>_reaction.cpp, declared `extern template` here),
+// so adding a kernel variant does not grow one file's compile time.
 #pragma once
 
 #include "integrators/explicit_kernel.hpp"
@@ -47,8 +48,9 @@ struct ModelKernels {
   }
 };
 
-template <class M> ModelKernels model_kernels() {
-  ModelKernels k{};
+// The explicit rows (integrators/kernels/<model>.cpp, no FMA contraction) and the reaction rows
+// (integrators/kernels/<model>_reaction.cpp, contracted: see CMakeLists.txt) of model M.
+template <class M> void explicit_kernels(ModelKernels& k) {
   k.explicit_row[0][0] = &explicit_row<M, 3, false, false>;
   k.explicit_row[0][1] = &explicit_row<M, 5, false, false>;
   k.explicit_row[0][2] = &explicit_row<M, 3, true, false>;
@@ -59,21 +61,41 @@ template <class M> ModelKernels model_kernels() {
   k.explicit_row[1][3] = &explicit_row<M, 9, true, true>;
   k.explicit_pre[0] = &explicit_row_pre<M, false>;
   k.explicit_pre[1] = &explicit_row_pre<M, true>;
+}
+
+template <class M> void reaction_kernels(ModelKernels& k) {
   k.reaction_row[0] = &reaction_row_lockstep<M, false>; // 2-3 species: lockstep Newton
   k.reaction_row[1] = &reaction_row_lockstep<M, true>;
+}
+
+template <class M> ModelKernels model_kernels() {
+  ModelKernels k{};
+  explicit_kernels<M>(k);
+  reaction_kernels<M>(k);
   return k;
 }
 
-extern template ModelKernels model_kernels<models::Turing>();
-extern template ModelKernels model_kernels<models::GrayScott>();
-extern template ModelKernels model_kernels<models::GrayScottSims>();
-extern template ModelKernels model_kernels<models::Brusselator>();
-extern template ModelKernels model_kernels<models::GiererMeinhardt>();
-extern template ModelKernels model_kernels<models::Meinhardt>();
-extern template ModelKernels model_kernels<models::Schnakenberg>();
-extern template ModelKernels model_kernels<models::FitzHughNagumo>();
-extern template ModelKernels model_kernels<models::Barkley>();
-extern template ModelKernels model_kernels<models::BarkleyTurbulent>();
-extern template ModelKernels model_kernels<models::Oregonator>();
+extern template void explicit_kernels<models::Turing>(ModelKernels&);
+extern template void reaction_kernels<models::Turing>(ModelKernels&);
+extern template void explicit_kernels<models::GrayScott>(ModelKernels&);
+extern template void reaction_kernels<models::GrayScott>(ModelKernels&);
+extern template void explicit_kernels<models::GrayScottSims>(ModelKernels&);
+extern template void reaction_kernels<models::GrayScottSims>(ModelKernels&);
+extern template void explicit_kernels<models::Brusselator>(ModelKernels&);
+extern template void reaction_kernels<models::Brusselator>(ModelKernels&);
+extern template void explicit_kernels<models::GiererMeinhardt>(ModelKernels&);
+extern template void reaction_kernels<models::GiererMeinhardt>(ModelKernels&);
+extern template void explicit_kernels<models::Meinhardt>(ModelKernels&);
+extern template void reaction_kernels<models::Meinhardt>(ModelKernels&);
+extern template void explicit_kernels<models::Schnakenberg>(ModelKernels&);
+extern template void reaction_kernels<models::Schnakenberg>(ModelKernels&);
+extern template void explicit_kernels<models::FitzHughNagumo>(ModelKernels&);
+extern template void reaction_kernels<models::FitzHughNagumo>(ModelKernels&);
+extern template void explicit_kernels<models::Barkley>(ModelKernels&);
+extern template void reaction_kernels<models::Barkley>(ModelKernels&);
+extern template void explicit_kernels<models::BarkleyTurbulent>(ModelKernels&);
+extern template void reaction_kernels<models::BarkleyTurbulent>(ModelKernels&);
+extern template void explicit_kernels<models::Oregonator>(ModelKernels&);
+extern template void reaction_kernels<models::Oregonator>(ModelKernels&);
 
 } // namespace morphogen

@@ -59,11 +59,17 @@ nlohmann::json run_point_impl(const SweepSpec& spec, long long p, const SweepSet
   const PetscInt steps = sim.steps();
   const PetscInt every = std::max<PetscInt>(1, steps / std::max<long long>(1, set.samples));
   std::string diverged;
+  const PetscInt nan_every = sim.output().nan_check_every;
   sampler.take(sim);
-  for (PetscInt n = 1; n <= steps && diverged.empty(); ++n) {
+  // Passes of up to fuse_steps() steps (-explicit_fuse_steps), each ending at the next sample
+  // or NaN check: bitwise the results of single steps.
+  for (PetscInt n = 0; n < steps && diverged.empty();) {
+    const PetscInt k =
+        std::min({sim.fuse_steps(), steps - n, every - n % every, nan_every - n % nan_every});
     try {
-      sim.step();
-      if (n % sim.output().nan_check_every == 0 || n == steps) sim.check_finite();
+      sim.advance(k);
+      n += k;
+      if (n % nan_every == 0 || n == steps) sim.check_finite();
     } catch (const UserError& e) {
       diverged = e.what();
     }

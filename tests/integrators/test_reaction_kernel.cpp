@@ -11,6 +11,7 @@
 //      (with the factor s on the 16 dt term that the paper's typesetting lost);
 //   5. failures (NaN input, overflow, singular Jacobian, Newton that does not converge) are
 //      reported, by reaction_row with the failing cell's index; in-place equals out-of-place.
+#include "../model_typed_tests.hpp"
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -48,13 +49,6 @@ const char* scheme_name(ReactionScheme s) {
   }
   return "?";
 }
-
-template <class Tuple> struct ToTypes;
-template <class... Ms> struct ToTypes<std::tuple<Ms...>> { using type = ::testing::Types<Ms...>; };
-
-struct ModelNames {
-  template <class M> static std::string GetName(int) { return M::name; }
-};
 
 template <class M> using State = std::array<double, M::nspecies>;
 
@@ -108,8 +102,7 @@ State<M> implicit_residual(ReactionScheme scheme, const State<M>& u, const doubl
 // ---------------------------------------------------------------------------------------------
 // 1. Every model near its steady state.
 
-template <class M> class ReactionKernelModels : public ::testing::Test {};
-TYPED_TEST_SUITE(ReactionKernelModels, ToTypes<AllModels>::type, ModelNames);
+MG_MODEL_TYPED_TEST_SUITE(ReactionKernelModels);
 
 TYPED_TEST(ReactionKernelModels, ImplicitSchemesConvergeNearTheSteadyState) {
   using M = TypeParam;

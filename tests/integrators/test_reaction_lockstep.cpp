@@ -13,6 +13,7 @@
 //     before it written;
 //   - the explicit schemes (Euler, Heun, Rk4: the vectorised row of reaction_explicit_kernel.hpp)
 //     agree with the per-cell path to an ulp and bitwise with themselves on a shifted row.
+#include "../model_typed_tests.hpp"
 #include <gtest/gtest.h>
 
 #include <array>
@@ -29,14 +30,7 @@ namespace {
 
 using namespace morphogen;
 
-template <class Tuple> struct ToTypes;
-template <class... Ms> struct ToTypes<std::tuple<Ms...>> { using type = ::testing::Types<Ms...>; };
-struct ModelNames {
-  template <class M> static std::string GetName(int) { return M::name; }
-};
-
-template <class M> class LockstepModels : public ::testing::Test {};
-TYPED_TEST_SUITE(LockstepModels, ToTypes<AllModels>::type, ModelNames);
+MG_MODEL_TYPED_TEST_SUITE(LockstepModels);
 
 // A row of n cells around the steady state (or the species' initial values), parameters per
 // cell within +-5 % of their defaults, sources of a few per cent of the state per unit time.

@@ -7,6 +7,7 @@
 //   4. consistent metadata (ranges contain the defaults, unique identifier-like names),
 //   5. linear stability of the steady state with the default parameters and diffusion; for
 //      the Turing-type models: stable without diffusion, unstable to some wavenumber k.
+#include "../model_typed_tests.hpp"
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -141,13 +142,6 @@ template <> struct Case<mm::Oregonator> {
   static constexpr TuringKind turing = TuringKind::unstable_k0;
 };
 
-template <class Tuple> struct ToTypes;
-template <class... Ms> struct ToTypes<std::tuple<Ms...>> { using type = ::testing::Types<Ms...>; };
-
-struct ModelNames {
-  template <class M> static std::string GetName(int) { return M::name; }
-};
-
 template <class M> std::array<double, M::nparams> defaults() {
   std::array<double, M::nparams> p{};
   for (int i = 0; i < M::nparams; ++i)
@@ -163,8 +157,7 @@ bool is_identifier(const char* s) {
   return true;
 }
 
-template <class M> class ModelTest : public ::testing::Test {};
-TYPED_TEST_SUITE(ModelTest, ToTypes<AllModels>::type, ModelNames);
+MG_MODEL_TYPED_TEST_SUITE(ModelTest);
 
 TYPED_TEST(ModelTest, RatesMatchHandComputedValues) {
   using M = TypeParam;

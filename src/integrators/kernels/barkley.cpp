@@ -1,6 +1,6 @@
-// The Barkley model's kernels (see integrators/model_kernels.hpp).
+// The Barkley model's explicit rows (see integrators/model_kernels.hpp).
 #include "integrators/model_kernels.hpp"
 
 namespace morphogen {
-template ModelKernels model_kernels<models::Barkley>();
+template void explicit_kernels<models::Barkley>(ModelKernels&);
 } // namespace morphogen

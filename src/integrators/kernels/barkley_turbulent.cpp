@@ -1,6 +1,6 @@
-// The BarkleyTurbulent model's kernels (see integrators/model_kernels.hpp).
+// The BarkleyTurbulent model's explicit rows (see integrators/model_kernels.hpp).
 #include "integrators/model_kernels.hpp"
 
 namespace morphogen {
-template ModelKernels model_kernels<models::BarkleyTurbulent>();
+template void explicit_kernels<models::BarkleyTurbulent>(ModelKernels&);
 } // namespace morphogen

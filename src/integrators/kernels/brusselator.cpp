@@ -1,6 +1,6 @@
-// The Brusselator model's kernels (see integrators/model_kernels.hpp).
+// The Brusselator model's explicit rows (see integrators/model_kernels.hpp).
 #include "integrators/model_kernels.hpp"
 
 namespace morphogen {
-template ModelKernels model_kernels<models::Brusselator>();
+template void explicit_kernels<models::Brusselator>(ModelKernels&);
 } // namespace morphogen

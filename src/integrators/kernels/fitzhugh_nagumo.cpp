@@ -1,6 +1,6 @@
-// The FitzHughNagumo model's kernels (see integrators/model_kernels.hpp).
+// The FitzHughNagumo model's explicit rows (see integrators/model_kernels.hpp).
 #include "integrators/model_kernels.hpp"
 
 namespace morphogen {
-template ModelKernels model_kernels<models::FitzHughNagumo>();
+template void explicit_kernels<models::FitzHughNagumo>(ModelKernels&);
 } // namespace morphogen

@@ -1,6 +1,6 @@
-// The GiererMeinhardt model's kernels (see integrators/model_kernels.hpp).
+// The GiererMeinhardt model's explicit rows (see integrators/model_kernels.hpp).
 #include "integrators/model_kernels.hpp"
 
 namespace morphogen {
-template ModelKernels model_kernels<models::GiererMeinhardt>();
+template void explicit_kernels<models::GiererMeinhardt>(ModelKernels&);
 } // namespace morphogen

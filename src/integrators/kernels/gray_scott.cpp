@@ -1,6 +1,6 @@
-// The GrayScott model's kernels (see integrators/model_kernels.hpp).
+// The GrayScott model's explicit rows (see integrators/model_kernels.hpp).
 #include "integrators/model_kernels.hpp"
 
 namespace morphogen {
-template ModelKernels model_kernels<models::GrayScott>();
+template void explicit_kernels<models::GrayScott>(ModelKernels&);
 } // namespace morphogen

@@ -1,6 +1,6 @@
-// The GrayScottSims model's kernels (see integrators/model_kernels.hpp).
+// The GrayScottSims model's explicit rows (see integrators/model_kernels.hpp).
 #include "integrators/model_kernels.hpp"
 
 namespace morphogen {
-template ModelKernels model_kernels<models::GrayScottSims>();
+template void explicit_kernels<models::GrayScottSims>(ModelKernels&);
 } // namespace morphogen

@@ -1,6 +1,6 @@
-// The Meinhardt model's kernels (see integrators/model_kernels.hpp).
+// The Meinhardt model's explicit rows (see integrators/model_kernels.hpp).
 #include "integrators/model_kernels.hpp"
 
 namespace morphogen {
-template ModelKernels model_kernels<models::Meinhardt>();
+template void explicit_kernels<models::Meinhardt>(ModelKernels&);
 } // namespace morphogen

@@ -1,6 +1,6 @@
-// The Oregonator model's kernels (see integrators/model_kernels.hpp).
+// The Oregonator model's explicit rows (see integrators/model_kernels.hpp).
 #include "integrators/model_kernels.hpp"
 
 namespace morphogen {
-template ModelKernels model_kernels<models::Oregonator>();
+template void explicit_kernels<models::Oregonator>(ModelKernels&);
 } // namespace morphogen

@@ -1,6 +1,6 @@
-// The Schnakenberg model's kernels (see integrators/model_kernels.hpp).
+// The Schnakenberg model's explicit rows (see integrators/model_kernels.hpp).
 #include "integrators/model_kernels.hpp"
 
 namespace morphogen {
-template ModelKernels model_kernels<models::Schnakenberg>();
+template void explicit_kernels<models::Schnakenberg>(ModelKernels&);
 } // namespace morphogen

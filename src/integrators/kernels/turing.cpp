@@ -1,6 +1,6 @@
-// The Turing model's kernels (see integrators/model_kernels.hpp).
+// The Turing model's explicit rows (see integrators/model_kernels.hpp).
 #include "integrators/model_kernels.hpp"
 
 namespace morphogen {
-template ModelKernels model_kernels<models::Turing>();
+template void explicit_kernels<models::Turing>(ModelKernels&);
 } // namespace morphogen

@@ -1,0 +1,6 @@
+// The FitzHughNagumo model's reaction rows, FMA contraction on (see integrators/model_kernels.hpp).
+#include "integrators/model_kernels.hpp"
+
+namespace morphogen {
+template void reaction_kernels<models::FitzHughNagumo>(ModelKernels&);
+} // namespace morphogen

@@ -1,0 +1,7 @@
+// The GiererMeinhardt model's reaction rows, FMA contraction on (see
+// integrators/model_kernels.hpp).
+#include "integrators/model_kernels.hpp"
+
+namespace morphogen {
+template void reaction_kernels<models::GiererMeinhardt>(ModelKernels&);
+} // namespace morphogen

@@ -1,0 +1,124 @@
+// The fused explicit row kernels as the integrator runs them (integrators/model_kernels.hpp:
+// each model's table, compiled as the library is) give every cell the same bits wherever it
+// lies in the row passed to them: for every compiled model, every row layout (5pt, 7pt, 9pt, the
+// 9-row box stencils by weight class and by 27 taps), scalar and per-cell parameters, a row of
+// 83 cells is swept whole and as every sub-row [i0, i0 + n) with i0 < 17 (so each cell is once
+// in a vector body and once in a loop remainder, for 256- and 512-bit vectors). A rank's rows
+// and a fused pass's tiles are such sub-rows, so this is what keeps explicit results
+// independent of the decomposition and of -explicit_fuse_steps bit for bit.
+#include "../model_typed_tests.hpp"
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "integrators/model_kernels.hpp"
+#include "models/all_models.hpp"
+
+namespace {
+
+using namespace morphogen;
+
+MG_MODEL_TYPED_TEST_SUITE(ExplicitRowPosition);
+
+constexpr int kN = 83; // cells in the row (a prime: no vector width divides it)
+
+// Rows of one layout for species s: NR rows of kN + 2 values (x = -1 .. kN), around the
+// species' initial value, every cell different.
+struct Rows {
+  int nr;
+  std::vector<std::vector<double>> data; // [s * nr + r]
+  std::vector<std::vector<double>> params;
+  Rows(int ns, int nr_, int np, const double* init, const double* pdef) : nr(nr_) {
+    for (int s = 0; s < ns; ++s)
+      for (int r = 0; r < nr; ++r) {
+        std::vector<double> v(kN + 2);
+        for (int i = 0; i < kN + 2; ++i)
+          v[i] = init[s] * (1.0 + 0.3 * std::sin(0.77 * i + 1.3 * r + 0.4 * s)) + 0.01 * r;
+        data.push_back(v);
+      }
+    for (int q = 0; q < np; ++q) {
+      std::vector<double> v(kN + 2);
+      for (int i = 0; i < kN + 2; ++i)
+        v[i] = pdef[q] * (1.0 + 0.05 * std::sin(0.3 * i + q));
+      params.push_back(v);
+    }
+  }
+};
+
+// Sweeps cells [i0, i0 + n) of the rows into out (kN values per species).
+template <class M>
+void sweep(ExplicitRowFn fn, const Rows& rows, const double* w, const double* wclass,
+           const double* pdef, bool field, int i0, int n, std::vector<std::vector<double>>& out) {
+  constexpr int NS = M::nspecies;
+  std::vector<const double*> src, prow;
+  std::vector<double*> dst;
+  for (const auto& r : rows.data)
+    src.push_back(r.data() + 1 + i0);
+  for (const auto& p : rows.params)
+    prow.push_back(p.data() + 1 + i0);
+  for (int s = 0; s < NS; ++s)
+    dst.push_back(out[s].data() + i0);
+  double D[NS], floor[NS];
+  for (int s = 0; s < NS; ++s) {
+    D[s] = 0.1 + 0.05 * s;
+    floor[s] = -HUGE_VAL;
+  }
+  ExplicitRow a;
+  a.n = n;
+  a.src = src.data();
+  a.w = w;
+  a.wclass = wclass;
+  a.D = D;
+  a.floor = floor;
+  a.prow = field ? prow.data() : nullptr;
+  a.pconst = pdef;
+  a.dt = 0.05;
+  a.dst = dst.data();
+  fn(a);
+}
+
+TYPED_TEST(ExplicitRowPosition, EveryCellTheSameBitsWhereverItLiesInTheRow) {
+  using M = TypeParam;
+  constexpr int NS = M::nspecies, NP = M::nparams;
+  ModelKernels k{};
+  explicit_kernels<M>(k);
+  double init[NS], pdef[NP > 0 ? NP : 1] = {};
+  for (int s = 0; s < NS; ++s)
+    init[s] = M::species[s].init != 0.0 ? M::species[s].init : 0.5;
+  for (int q = 0; q < NP; ++q)
+    pdef[q] = M::params[q].def;
+  struct Layout {
+    int nr;
+    bool box, classes;
+  };
+  for (const Layout& L : {Layout{3, false, false}, Layout{5, false, false}, Layout{3, true, false},
+                          Layout{9, true, false}, Layout{9, true, true}})
+    for (bool field : {false, true}) {
+      SCOPED_TRACE(std::to_string(L.nr) + (L.box ? " box" : " star") +
+                   (L.classes ? " by class" : "") + (field ? " field" : " scalar"));
+      const Rows rows(NS, L.nr, NP, init, pdef);
+      std::vector<double> w(3 * static_cast<size_t>(L.nr));
+      for (size_t t = 0; t < w.size(); ++t)
+        w[t] = 0.05 + 0.01 * static_cast<double>(t % 5);
+      const double wclass[4] = {-2.0, 0.3, 0.05, 0.01};
+      const ExplicitRowFn fn = k.row_kernel(field, L.nr, L.box);
+      std::vector<std::vector<double>> whole(NS, std::vector<double>(kN));
+      sweep<M>(fn, rows, w.data(), L.classes ? wclass : nullptr, pdef, field, 0, kN, whole);
+      long differ = 0;
+      for (int i0 = 0; i0 < 17; ++i0)
+        for (int n = 1; i0 + n <= kN; n += 3) {
+          std::vector<std::vector<double>> part(NS, std::vector<double>(kN));
+          sweep<M>(fn, rows, w.data(), L.classes ? wclass : nullptr, pdef, field, i0, n, part);
+          for (int s = 0; s < NS; ++s)
+            for (int i = i0; i < i0 + n; ++i)
+              differ += std::memcmp(&part[s][i], &whole[s][i], sizeof(double)) != 0 ? 1 : 0;
+        }
+      EXPECT_EQ(differ, 0) << "cells whose bits depend on their place in the row";
+    }
+}
+
+} // namespace
