@@ -43,7 +43,7 @@ MG_HD inline void explicit_cell(const double* const* u, long c, const CellStenci
     for (int q = 1; q < NR; ++q) {
       const double* row = us + st.roff[q];
       if constexpr (Box)
-        lap = fma(st.w[q][2], row[1], fma(st.w[q][1], row[0], fma(st.w[q][0], row[-1], lap)));
+        lap += fma(st.w[q][2], row[1], fma(st.w[q][1], row[0], st.w[q][0] * row[-1]));
       else
         lap = fma(st.w[q][1], row[0], lap);
     }

@@ -5,8 +5,9 @@
 // For each cell i of the row and each species s:
 //   lap_s = sum_r ( w[r][0] u_s,r[i-1] + w[r][1] u_s,r[i] + w[r][2] u_s,r[i+1] )
 //   out_s = max( u_s + dt (D_s lap_s + R_s(u; p)),  floor_s )
-// evaluated as a fixed chain of fused multiply-adds (std::fma, left to right over the taps;
-// out = fma(dt, fma(D, lap, R), u)), the same for every cell wherever it lies in a row: the
+// evaluated as fixed fused multiply-adds (std::fma: per row a chain left to right over its taps,
+// box rows then added to the sum, star rows' one tap fused into it; out = fma(dt, fma(D, lap,
+// R), u)), the same for every cell wherever it lies in a row: the
 // project is compiled without FMA contraction (CMakeLists.txt), which could otherwise pair the
 // operations differently in a loop's vector body and its remainder.
 // Star stencils (5pt, 7pt: Box = false) use only the centre tap of rows r > 0; box stencils
@@ -198,9 +199,8 @@ inline void explicit_row(const ExplicitRow& a) {
         double lap = std::fma(w[0][2], c[i + 1], std::fma(w[0][1], u[s], w[0][0] * c[i - 1]));
         for (int q = 1; q < NR; ++q) {
           const double* __restrict__ row = src[s * NR + q];
-          if constexpr (Box)
-            lap = std::fma(w[q][2], row[i + 1],
-                           std::fma(w[q][1], row[i], std::fma(w[q][0], row[i - 1], lap)));
+          if constexpr (Box) // the row's three taps, then added (independent chains per row)
+            lap += std::fma(w[q][2], row[i + 1], std::fma(w[q][1], row[i], w[q][0] * row[i - 1]));
           else
             lap = std::fma(w[q][1], row[i], lap);
         }
