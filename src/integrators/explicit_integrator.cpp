@@ -39,7 +39,8 @@ void ExplicitIntegrator::use_operators(std::vector<const DiffusionOperator*> ops
 
 void ExplicitIntegrator::update_ghosts(std::vector<VecH>& u) const {
   LogScope log_scope(log_events().halo);
-  std::vector<PetscScalar*> a(ns_);
+  std::vector<PetscScalar*>& a = tab_.in;
+  a.assign(static_cast<size_t>(ns_), nullptr);
   for (int s = 0; s < ns_; ++s)
     MG_PETSC(VecGetArray(u[s], &a[s]));
   for (int s = 0; s < ns_; ++s)
@@ -283,8 +284,13 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
   const bool field_mode = params_.any_field();
   const bool in_place = work == nullptr; // in_place()
   if (in_place) ring_.resize(static_cast<size_t>(ns_) * ring_depth_ * ring_n_);
-  std::vector<PetscScalar*> in(ns_), out(ns_);
-  std::vector<const PetscScalar*> pf(np, nullptr);
+  SweepTables& tb = tab_;
+  auto& in = tb.in;
+  auto& out = tb.out;
+  auto& pf = tb.pf;
+  in.assign(static_cast<size_t>(ns_), nullptr);
+  out.assign(static_cast<size_t>(ns_), nullptr);
+  pf.assign(static_cast<size_t>(np), nullptr);
   for (int s = 0; s < ns_; ++s) {
     MG_PETSC(VecGetArray(u[s], &in[s]));
     if (!in_place) MG_PETSC(VecGetArray((*work)[s], &out[s]));
@@ -294,16 +300,24 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
 
   const Box& ob = grid_.owned();
   const PetscInt gx = grid_.ghosted().m[0], gxy = gx * grid_.ghosted().m[1];
-  std::vector<PetscInt> delta(nr), dy(nr), dz(nr);
+  auto& delta = tb.delta;
+  auto& dy = tb.dy;
+  auto& dz = tb.dz;
+  delta.resize(static_cast<size_t>(nr));
+  dy.resize(static_cast<size_t>(nr));
+  dz.resize(static_cast<size_t>(nr));
   for (int r = 0; r < nr; ++r) {
     const int q = by_class_ ? classes_.perm[r] : r;
     dy[r] = rows_.off[q][0];
     dz[r] = rows_.off[q][1];
     delta[r] = gx * dy[r] + gxy * dz[r];
   }
-  std::vector<const double*> src(static_cast<size_t>(ns_ * nr));
-  std::vector<double*> dst(ns_);
-  std::vector<const double*> prow(np, nullptr);
+  auto& src = tb.src;
+  auto& dst = tb.dst;
+  auto& prow = tb.prow;
+  src.assign(static_cast<size_t>(ns_ * nr), nullptr);
+  dst.assign(static_cast<size_t>(ns_), nullptr);
+  prow.assign(static_cast<size_t>(np), nullptr);
   ExplicitRow row;
   row.n = static_cast<int>(ob.m[0]);
   row.src = src.data();

@@ -143,7 +143,17 @@ private:
   mutable std::vector<double> ring_;    // in-place sweeps: [ns][depth][nx] new rows
   int ring_depth_ = 2;                  // R_z bh + R_y + 1 (bh: block_rows())
   mutable std::vector<double> edge_[2]; // in-place 3-D blocks: [ns][ghosted z][ghosted x]
-  size_t ring_n_ = 0;                   // owned cells per row
+  // Pointer and offset tables of sweep() and update_ghosts(), kept between calls so that a step
+  // of a small grid (a sweep point) allocates nothing.
+  struct SweepTables {
+    std::vector<PetscScalar*> in, out;
+    std::vector<const PetscScalar*> pf;
+    std::vector<PetscInt> delta, dy, dz;
+    std::vector<const double*> src, prow;
+    std::vector<double*> dst;
+  };
+  mutable SweepTables tab_;
+  size_t ring_n_ = 0; // owned cells per row
   InPlace in_place_ = InPlace::Auto;
   std::vector<std::vector<double>> rates_; // owned layout, per species (other terms)
   int fuse_request_ = 1;
