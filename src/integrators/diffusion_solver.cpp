@@ -197,9 +197,11 @@ void DiffusionSolver::prepare(double dt, double theta) {
 }
 
 bool DiffusionSolver::solve_local(int s, Vec ulocal, double dt, double theta) {
-  if (ops_.scale(s) == 0.0 || ops_.has_dirichlet() || !use_spectral(s) ||
-      !spectral_[s]->steps_local())
-    return false;
+  if (ops_.scale(s) == 0.0) { // no diffusion: nothing to do (as in solve)
+    iterations_[s] = 0;
+    return true;
+  }
+  if (ops_.has_dirichlet() || !use_spectral(s) || !spectral_[s]->steps_local()) return false;
   LogScope log_scope(log_events().diffusion);
   spectral_[s]->step_local(ulocal, dt * ops_.scale(s), theta);
   iterations_[s] = 0;

@@ -220,7 +220,7 @@ inline void lockstep_store(const LockstepLanes<NS, NP, W>& L, int i0, const doub
   }
 }
 
-// The implicit row (2-3 species, maxit >= 1): chunks of kLockstepLanes cells. 32 lanes keep
+// The implicit row (2-3 species, maxit >= 1): chunks of kLockstepLanes cells. 64 lanes keep
 // enough independent vectors in flight that a Newton step's dependency chain (Jacobian, the
 // division of Cramer's rule, rates, masks) does not set the pace; a lane's arithmetic does
 // not depend on the chunk width.

@@ -349,11 +349,10 @@ void TridiagonalSolver::truncate_spikes() {
   zero_.assign(n, 0.0);
 }
 
-// x = scale (I - theta c M)^-1 (s0 + s1 M) r with scale = 1 / norm folded into s0, s1.
+// x = (I - theta c M)^-1 (s0 + s1 M) r.
 void TridiagonalSolver::apply(Vec r, Vec x, double s0, double s1) {
-  const double scale = 1.0 / t_->norm();
   PlaneView v = t_->reals(r, true);
-  down(v, scale * s0, scale * s1);
+  down(v, s0, s1);
   if (x != r) {
     t_->reals_done(r, v, false);
     v = t_->reals(x, false);
@@ -363,11 +362,14 @@ void TridiagonalSolver::apply(Vec r, Vec x, double s0, double s1) {
   t_->reals_done(x, v, true);
 }
 
-// Plane by plane: the transform, the right-hand side s0 f + s1 M f (the neighbours' edge planes
-// exchanged first), the forward elimination of the interior rows.
+// Plane by plane: the transform, the right-hand side (s0 f + s1 M f) / norm (the neighbours'
+// edge planes exchanged first; the transform's 1/norm folded in), the forward elimination of
+// the interior rows.
 void TridiagonalSolver::down(const PlaneView& in, double s0, double s1) {
   const PetscInt ni = m_ - 2;
   const bool product = s1 != 0.0;
+  s0 /= t_->norm();
+  s1 /= t_->norm();
   if (product) {
     t_->plane_forward(in, 0, row(0));
     t_->plane_forward(in, m_ - 1, row(m_ - 1));
@@ -436,7 +438,7 @@ void TridiagonalSolver::ends(const PlaneView& out) {
 
 void TridiagonalSolver::step(Vec u, double c, double theta) {
   factor(c, theta);
-  apply(u, u, 1.0, theta != 1.0 ? (1.0 - theta) * c : 0.0);
+  apply(u, u, 1.0, explicit_part(c, theta));
 }
 
 // The owned planes of a ghosted local vector are layout A when the DMDA is split in slabs.
@@ -453,8 +455,7 @@ void TridiagonalSolver::step_local(Vec ulocal, double c, double theta) {
   v.plane = three ? gb.m[0] * gb.m[1] : gb.m[0];
   v.rows = three ? grid_.spec().n[1] : 1;
   v.len = grid_.spec().n[0];
-  const double scale = 1.0 / t_->norm();
-  down(v, scale, theta != 1.0 ? scale * (1.0 - theta) * c : 0.0);
+  down(v, 1.0, explicit_part(c, theta));
   up(v);
   ends(v);
   double* b = a;

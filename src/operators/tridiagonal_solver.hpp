@@ -69,7 +69,11 @@ private:
   std::vector<double> reduced_rows() const;
   void reduced_inverse();
   void truncate_spikes();
-  // One substep, x = scale (I - theta c M)^-1 (s0 + s1 M) r (s1 = 0: no product), in three passes
+  // Crank-Nicolson's explicit factor (1 - theta) c (0 for backward Euler: no product).
+  static double explicit_part(double c, double theta) {
+    return theta != 1.0 ? (1.0 - theta) * c : 0.0;
+  }
+  // One substep, x = (I - theta c M)^-1 (s0 + s1 M) r (s1 = 0: no product), in three passes
   // over the planes: down (transform, product, forward elimination), up (back substitution; the
   // rows the spikes do not reach go back to x at once), ends (reduced system, the other rows).
   void apply(Vec r, Vec x, double s0, double s1);
