@@ -2,8 +2,9 @@
 // (integrators/explicit_kernel.hpp) for the CUDA path, with the same operations in the same
 // order (the same fused multiply-adds: fma here, std::fma there). For each species s, with the
 // stencil in row form (grid/stencil.hpp, RowStencil):
-//   lap_s = sum_r ( w[r][0] u_s(x-1, r) + w[r][1] u_s(x, r) + w[r][2] u_s(x+1, r) )
-//   out_s = max( u_s + dt (D_s lap_s + R_s(u; p)),  floor_s )
+//   out_s = max( fma(dt, R_s, u_s) + sum_r sum_c W_s[r][c] u_s(x+c-1, r),  floor_s )
+// with W_s[r][c] = (dt D_s) w[r][c] (the Euler step u + dt (D lap + R), dt D folded into the
+// weights).
 // u[s] is species s's ghosted array and c the cell's index in it; stencil row r starts at
 // c + roff[r] (roff[0] = 0) and x neighbours are at -+1. Star stencils (Box = false) use only the
 // centre tap of rows r > 0. out[s][o] receives the result (o: the cell's index in the output).
@@ -39,15 +40,16 @@ MG_HD inline void explicit_cell(const double* const* u, long c, const CellStenci
   M::rates(uc, k.p, r);
   for (int s = 0; s < NS; ++s) {
     const double* us = u[s] + c;
-    double lap = fma(st.w[0][2], us[1], fma(st.w[0][1], uc[s], st.w[0][0] * us[-1]));
+    const double f = k.dt * k.D[s];
+    double v = fma(k.dt, r[s], uc[s]);
+    v = fma(f * st.w[0][2], us[1], fma(f * st.w[0][1], uc[s], fma(f * st.w[0][0], us[-1], v)));
     for (int q = 1; q < NR; ++q) {
       const double* row = us + st.roff[q];
       if constexpr (Box)
-        lap += fma(st.w[q][2], row[1], fma(st.w[q][1], row[0], st.w[q][0] * row[-1]));
+        v += fma(f * st.w[q][2], row[1], fma(f * st.w[q][1], row[0], (f * st.w[q][0]) * row[-1]));
       else
-        lap = fma(st.w[q][1], row[0], lap);
+        v = fma(f * st.w[q][1], row[0], v);
     }
-    const double v = fma(k.dt, fma(k.D[s], lap, r[s]), uc[s]);
     out[s][o] = clamp_to_floor(v, k.floor[s]);
   }
 }

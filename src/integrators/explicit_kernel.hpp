@@ -3,20 +3,23 @@
 // The Laplacian is given in row form (grid/stencil.hpp, RowStencil): NR grid rows
 // (row 0 is the cell's own row), each with three x-taps w[r][0..2] for x offsets -1, 0, +1.
 // For each cell i of the row and each species s:
-//   lap_s = sum_r ( w[r][0] u_s,r[i-1] + w[r][1] u_s,r[i] + w[r][2] u_s,r[i+1] )
-//   out_s = max( u_s + dt (D_s lap_s + R_s(u; p)),  floor_s )
-// evaluated as fixed fused multiply-adds (std::fma: per row a chain left to right over its taps,
-// box rows then added to the sum, star rows' one tap fused into it; out = fma(dt, fma(D, lap,
-// R), u)), the same for every cell wherever it lies in a row: the
-// project is compiled without FMA contraction (CMakeLists.txt), which could otherwise pair the
-// operations differently in a loop's vector body and its remainder.
+//   out_s = max( u_s + dt R_s(u; p) + sum_r sum_c W_s[r][c] u_s,r[i+c-1],  floor_s )
+// with the taps scaled once per call, W_s[r][c] = (dt D_s) w[r][c] (the Euler step
+// u + dt (D lap + R) with dt D folded into the weights: one multiply-add per cell and species
+// fewer). Evaluated as fixed fused multiply-adds (std::fma): the sum starts at
+// fma(dt, R_s, u_s), row 0's taps are fused into it left to right, box rows' taps are fused
+// among themselves and then added, star rows' one tap is fused in; the same for every cell
+// wherever it lies in a row: the project is compiled without FMA contraction (CMakeLists.txt),
+// which could otherwise pair the operations differently in a loop's vector body and its
+// remainder.
 // Star stencils (5pt, 7pt: Box = false) use only the centre tap of rows r > 0; box stencils
 // (9pt) use all three. One pointer per (species, row) keeps the live registers low (the x
 // neighbours are the same pointer at i -+ 1). floor_s is 0 when negative concentrations are
-// clamped and -inf otherwise (branch-free). Parameters are scalars (FieldParams = false: kept
-// in registers) or rows of per-cell values (FieldParams = true). The loop over i carries
-// `GCC ivdep` (rows never alias); the model's rates() inline into it and GCC vectorises it
-// (configure with -DMORPHOGEN_VEC_REPORT=ON to see "loop vectorized" for this file).
+// clamped and -inf otherwise; a row whose floors are all -inf takes an instantiation without
+// the max (Clamp = false: the same values, max(v, -inf) = v, NaN kept). Parameters are scalars
+// (FieldParams = false: kept in registers) or rows of per-cell values (FieldParams = true). The
+// loop over i carries `GCC ivdep` (rows never alias); the model's rates() inline into it and GCC
+// vectorises it (configure with -DMORPHOGEN_VEC_REPORT=ON to see "loop vectorized" for this file).
 // (`omp simd` is not used: GCC 12 turns the small per-cell arrays into "simd arrays" and then
 // refuses to vectorise.)
 // The 3-D box stencils (19pt, 27pt: 9 rows) take the weight-class path
@@ -88,26 +91,35 @@ inline void box_row_profiles(const double* const* rows, const double* w, int x0,
 // The 9-row box stencils by weight class (19pt, 27pt; ExplicitRow::wclass set), rows in class
 // order: src[s*9] the centre row, src[s*9 + 1..4] the face rows, src[s*9 + 5..8] the corner
 // rows. Per chunk of up to kBoxChunk cells, first the profiles p and q of box_row_profiles at
-// x = i-1 .. i+1 into stack buffers, then per cell
-//   lap = q(i) + (p(i-1) + p(i+1))
-// and the update of explicit_row. Per cell and species: 9 loads, 6 adds and 4-6 multiply-adds
-// for the profiles, 3 loads and 2 adds for lap, instead of 27 loads and 27 multiply-adds.
-// Each value is one fixed expression of the cell's neighbours, so neither the chunks nor the
-// rank decomposition change a bit.
+// x = i-1 .. i+1 into stack buffers, with the class weights scaled by dt D_s, then per cell
+//   out_s = max( fma(dt, R_s, u_s) + (q(i) + (p(i-1) + p(i+1))),  floor_s ).
+// Per cell and species: 9 loads, 6 adds and 4-6 multiply-adds for the profiles, 3 loads and
+// 2 adds for the taps, instead of 27 loads and 27 multiply-adds. Each value is one fixed
+// expression of the cell's neighbours, so neither the chunks nor the rank decomposition change
+// a bit.
 constexpr int kBoxChunk = 128;
 
-template <class M, bool FieldParams, bool Corners>
+// True when some species has a finite floor (the max of the update is needed).
+inline bool any_floor(const double* floor, int ns) {
+  for (int s = 0; s < ns; ++s)
+    if (floor[s] != -HUGE_VAL) return true;
+  return false;
+}
+
+template <class M, bool FieldParams, bool Corners, bool Clamp>
 inline void explicit_row_box_classes(const ExplicitRow& a) {
   constexpr int NS = M::nspecies;
   constexpr int NP = M::nparams;
   const double* __restrict__ src[NS];
   double* __restrict__ dst[NS];
-  double D[NS], floor[NS], pc[NP > 0 ? NP : 1];
+  double wc[NS][4], floor[NS], pc[NP > 0 ? NP : 1];
   const double* __restrict__ prow[NP > 0 ? NP : 1];
+  const double dt = a.dt;
   for (int s = 0; s < NS; ++s) {
     src[s] = a.src[s * 9];
     dst[s] = a.dst[s];
-    D[s] = a.D[s];
+    for (int c = 0; c < 4; ++c)
+      wc[s][c] = (dt * a.D[s]) * a.wclass[c];
     floor[s] = a.floor[s];
   }
   for (int q = 0; q < NP; ++q) {
@@ -116,13 +128,12 @@ inline void explicit_row_box_classes(const ExplicitRow& a) {
     else
       pc[q] = a.pconst[q];
   }
-  const double dt = a.dt;
   const int n = a.n;
   double pbuf[NS][kBoxChunk + 2], qbuf[NS][kBoxChunk + 2]; // at x = i0 - 1 .. i0 + m
   for (int i0 = 0; i0 < n; i0 += kBoxChunk) {
     const int m = n - i0 < kBoxChunk ? n - i0 : kBoxChunk;
     for (int s = 0; s < NS; ++s)
-      box_row_profiles<Corners>(a.src + s * 9, a.wclass, i0 - 1, m + 2, pbuf[s], qbuf[s]);
+      box_row_profiles<Corners>(a.src + s * 9, wc[s], i0 - 1, m + 2, pbuf[s], qbuf[s]);
 #pragma GCC ivdep
     for (int x = 0; x < m; ++x) {
       const int i = i0 + x;
@@ -137,39 +148,30 @@ inline void explicit_row_box_classes(const ExplicitRow& a) {
         u[s] = src[s][i];
       M::rates(u, p, r);
       for (int s = 0; s < NS; ++s) {
-        const double lap = qbuf[s][x + 1] + (pbuf[s][x] + pbuf[s][x + 2]);
-        const double v = std::fma(dt, std::fma(D[s], lap, r[s]), u[s]);
-        dst[s][i] = clamp_to_floor(v, floor[s]);
+        const double v =
+            std::fma(dt, r[s], u[s]) + (qbuf[s][x + 1] + (pbuf[s][x] + pbuf[s][x + 2]));
+        dst[s][i] = Clamp ? clamp_to_floor(v, floor[s]) : v;
       }
     }
   }
 }
 
-template <class M, int NR, bool Box, bool FieldParams>
-inline void explicit_row(const ExplicitRow& a) {
-  if constexpr (NR == 9 && Box) {
-    if (a.wclass) {
-      if (a.wclass[3] != 0.0)
-        explicit_row_box_classes<M, FieldParams, true>(a);
-      else
-        explicit_row_box_classes<M, FieldParams, false>(a);
-      return;
-    }
-  }
+template <class M, int NR, bool Box, bool FieldParams, bool Clamp>
+inline void explicit_row_taps(const ExplicitRow& a) {
   constexpr int NS = M::nspecies;
   constexpr int NP = M::nparams;
   const double* __restrict__ src[NS * NR];
   double* __restrict__ dst[NS];
-  double w[NR][3], D[NS], floor[NS], pc[NP > 0 ? NP : 1];
+  double w[NS][NR][3], floor[NS], pc[NP > 0 ? NP : 1];
   const double* __restrict__ prow[NP > 0 ? NP : 1];
+  const double dt = a.dt;
   for (int q = 0; q < NS * NR; ++q)
     src[q] = a.src[q];
-  for (int r = 0; r < NR; ++r)
-    for (int c = 0; c < 3; ++c)
-      w[r][c] = a.w[3 * r + c];
   for (int s = 0; s < NS; ++s) {
+    for (int r = 0; r < NR; ++r)
+      for (int c = 0; c < 3; ++c)
+        w[s][r][c] = (dt * a.D[s]) * a.w[3 * r + c];
     dst[s] = a.dst[s];
-    D[s] = a.D[s];
     floor[s] = a.floor[s];
   }
   for (int q = 0; q < NP; ++q) {
@@ -178,7 +180,6 @@ inline void explicit_row(const ExplicitRow& a) {
     else
       pc[q] = a.pconst[q];
   }
-  const double dt = a.dt;
   const int n = a.n;
   const int rows = FieldParams ? 1 : a.rows;
   for (int j = 0; j < rows; ++j) {
@@ -196,16 +197,17 @@ inline void explicit_row(const ExplicitRow& a) {
       M::rates(u, p, r);
       for (int s = 0; s < NS; ++s) {
         const double* __restrict__ c = src[s * NR];
-        double lap = std::fma(w[0][2], c[i + 1], std::fma(w[0][1], u[s], w[0][0] * c[i - 1]));
+        const double(&ws)[NR][3] = w[s];
+        double v = std::fma(dt, r[s], u[s]);
+        v = std::fma(ws[0][2], c[i + 1], std::fma(ws[0][1], u[s], std::fma(ws[0][0], c[i - 1], v)));
         for (int q = 1; q < NR; ++q) {
           const double* __restrict__ row = src[s * NR + q];
           if constexpr (Box) // the row's three taps, then added (independent chains per row)
-            lap += std::fma(w[q][2], row[i + 1], std::fma(w[q][1], row[i], w[q][0] * row[i - 1]));
+            v += std::fma(ws[q][2], row[i + 1], std::fma(ws[q][1], row[i], ws[q][0] * row[i - 1]));
           else
-            lap = std::fma(w[q][1], row[i], lap);
+            v = std::fma(ws[q][1], row[i], v);
         }
-        const double v = std::fma(dt, std::fma(D[s], lap, r[s]), u[s]);
-        dst[s][i] = clamp_to_floor(v, floor[s]);
+        dst[s][i] = Clamp ? clamp_to_floor(v, floor[s]) : v;
       }
     }
     for (int q = 0; q < NS * NR; ++q)
@@ -213,6 +215,29 @@ inline void explicit_row(const ExplicitRow& a) {
     for (int s = 0; s < NS; ++s)
       dst[s] += a.dst_stride;
   }
+}
+
+template <class M, int NR, bool Box, bool FieldParams>
+inline void explicit_row(const ExplicitRow& a) {
+  const bool clamp = any_floor(a.floor, M::nspecies);
+  if constexpr (NR == 9 && Box) {
+    if (a.wclass) {
+      const bool corners = a.wclass[3] != 0.0;
+      if (clamp && corners)
+        explicit_row_box_classes<M, FieldParams, true, true>(a);
+      else if (clamp)
+        explicit_row_box_classes<M, FieldParams, false, true>(a);
+      else if (corners)
+        explicit_row_box_classes<M, FieldParams, true, false>(a);
+      else
+        explicit_row_box_classes<M, FieldParams, false, false>(a);
+      return;
+    }
+  }
+  if (clamp)
+    explicit_row_taps<M, NR, Box, FieldParams, true>(a);
+  else
+    explicit_row_taps<M, NR, Box, FieldParams, false>(a);
 }
 
 // The general path's update of one row: the diffusion terms were computed into div[s] (a row
