@@ -634,7 +634,7 @@ void Simulation::step() {
 void Simulation::read_fuse(Options& opt) {
   const char* key = "explicit_fuse_steps";
   if (split_ || ts_) {
-    for (const char* k : {key, "explicit_in_place"})
+    for (const char* k : {key, "explicit_in_place", "explicit_fuse_tile"})
       if (opt.is_set(k))
         throw UserError(std::string("-") + k + ": applies to -integrator explicit only");
     if (split_fuse_) read_split_fuse();
@@ -645,6 +645,10 @@ void Simulation::read_fuse(Options& opt) {
       "explicit steps fused per pass over the grid (temporal blocking: a k-cell halo exchanged "
       "once per k steps; 2-D periodic fast path, else 1; results bitwise those of 1)");
   integrator_->set_fuse_steps(static_cast<int>(k));
+  integrator_->set_fuse_tile(opt.integer(
+      "explicit_fuse_tile", 0, 0, 1 << 30,
+      "owned columns per tile of a fused pass (0: automatic, the widest tile whose rows of the k "
+      "steps stay within 1 MiB, half a typical L2 cache); the same results for any width"));
   const std::string in_place = opt.choice(
       "explicit_in_place", "auto", {"auto", "yes", "no"},
       "fast path (2-D and 3-D): update the state in place, with no second state set (8 bytes per "

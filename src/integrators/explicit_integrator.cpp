@@ -192,7 +192,7 @@ void ExplicitIntegrator::steps(std::vector<VecH>& u, double t, double dt, int n)
     for (int s = 0; s < ns_; ++s)
       work_.push_back(grid_.create_local());
   if (!fused_) {
-    fused_ = std::make_unique<FusedSweep>(grid_, rows_, ns_, fuse_steps());
+    fused_ = std::make_unique<FusedSweep>(grid_, rows_, ns_, fuse_steps(), fuse_tile_);
     if (params_.any_field()) fused_->set_params(params_); // fixed in time (no fusion otherwise)
   }
   if (terms_) terms_->set_time(t);

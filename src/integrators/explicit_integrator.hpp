@@ -89,6 +89,8 @@ public:
 
   // Temporal blocking: up to k >= 1 steps per pass (1: one step per pass, the default).
   void set_fuse_steps(int k) { fuse_request_ = k; }
+  // Owned columns per tile of the fused sweep (0: automatic, FusedSweep::tile_width).
+  void set_fuse_tile(PetscInt columns) { fuse_tile_ = columns; }
   // Why this run cannot fuse steps ("" when it can).
   std::string fuse_unsupported() const;
   // Steps steps() may fuse: the requested k where supported, else 1.
@@ -157,6 +159,7 @@ private:
   InPlace in_place_ = InPlace::Auto;
   std::vector<std::vector<double>> rates_; // owned layout, per species (other terms)
   int fuse_request_ = 1;
+  PetscInt fuse_tile_ = 0;
   std::unique_ptr<FusedSweep> fused_; // built on the first fused call
 };
 

@@ -16,14 +16,15 @@ int FusedSweep::radius(const RowStencil& rows) {
   return r;
 }
 
-FusedSweep::FusedSweep(const Grid& grid, const RowStencil& rows, int nspecies, int depth)
-    : grid_(grid), rows_(rows), ns_(nspecies), depth_(depth), r_(radius(rows)),
+FusedSweep::FusedSweep(const Grid& grid, const RowStencil& rows, int nspecies, int depth,
+                       PetscInt tile)
+    : grid_(grid), rows_(rows), ns_(nspecies), depth_(depth), tile_(tile), r_(radius(rows)),
       frame_(grid, depth * radius(rows)), ring_(2 * radius(rows) + 1) {
   // Rows padded to whole cache lines, plus one line against cache-set aliasing of the ring.
   stride_ = (frame_.lx() + 7) / 8 * 8 + 8;
   frame_buf_.assign(static_cast<size_t>(ns_), std::vector<double>(frame_.size()));
   ring_buf_.assign(static_cast<size_t>(depth_ * ns_ * ring_ * stride_), 0.0);
-  in0_.assign(static_cast<size_t>(ns_), std::vector<const double*>(ring_, nullptr));
+  in0_.assign(static_cast<size_t>(ns_), std::vector<InputRow>(ring_));
 }
 
 void FusedSweep::set_params(const ParamSet& params) {
@@ -53,20 +54,38 @@ void FusedSweep::set_params(const ParamSet& params) {
   }
 }
 
-// Row jw of the input box: the frame's row itself outside the owned rows, else left strip,
-// owned row and right strip copied into the level-0 ring.
-const double* FusedSweep::input_row(const std::vector<const double*>& in, int s,
-                                    PetscInt jw) const {
+// Row jw of the input box for step 1, as two bases indexed by box column x: `edge` for the
+// columns within 2 cells of the strips, `mid` for the owned columns. Outside the owned rows both
+// are the frame's row. An owned row is read in place (mid = the owned row, shifted by W); only
+// the strips and the owned row's first and last two cells are copied into the level-0 ring
+// (edge), so step 1's row splits into three calls (run). Narrow rows (mx < kInPlaceMin) are
+// copied whole (edge = mid = the ring row).
+FusedSweep::InputRow FusedSweep::input_row(const std::vector<const double*>& in, int s,
+                                           PetscInt jw) const {
   const double* f = frame_buf_[s].data() + frame_.row_offset(jw);
-  if (!frame_.owned_row(jw)) return f;
+  if (!frame_.owned_row(jw)) return {f, f};
   const Box& ob = grid_.owned();
   const PetscInt W = frame_.width(), mx = ob.m[0];
   double* row = ring_row(0, s, jw);
   const double* own = in[s] + grid_.local_index(ob.s[0], ob.s[1] - W + jw, 0);
   std::memcpy(row, f, sizeof(double) * W);
-  std::memcpy(row + W, own, sizeof(double) * mx);
   std::memcpy(row + W + mx, f + W, sizeof(double) * W);
-  return row;
+  if (mx < kInPlaceMin) {
+    std::memcpy(row + W, own, sizeof(double) * mx);
+    return {row, row};
+  }
+  std::memcpy(row + W, own, sizeof(double) * 2);
+  std::memcpy(row + W + mx - 2, own + mx - 2, sizeof(double) * 2);
+  return {row, own - W};
+}
+
+// Columns per tile: the given width, else the widest whose ring rows (ring_ rows of `depth`
+// levels and ns_ species, its columns plus the 2W halo) stay within kTileBytes.
+PetscInt FusedSweep::tile_width() const {
+  if (tile_ > 0) return tile_;
+  const double per_column = 8.0 * static_cast<double>(ring_ * depth_ * ns_);
+  const PetscInt fit = static_cast<PetscInt>(kTileBytes / per_column) - 2 * frame_.width();
+  return std::max<PetscInt>(kInPlaceMin, fit);
 }
 
 void FusedSweep::run(const std::vector<const double*>& in, const std::vector<double*>& out, int n,
@@ -79,8 +98,19 @@ void FusedSweep::run(const std::vector<const double*>& in, const std::vector<dou
     frame_.fill(in, f);
   }
   LogScope log_scope(log_events().sweep);
+  const PetscInt W = frame_.width(), mx = grid_.owned().m[0];
+  const PetscInt tiles = std::max<PetscInt>(1, (mx + tile_width() - 1) / tile_width());
+  for (PetscInt t = 0; t < tiles; ++t)
+    sweep_tile(in, out, n, row, fn, W + t * mx / tiles, W + (t + 1) * mx / tiles);
+}
+
+// The owned box columns [t0, t1) (box coordinates): step l computes the columns
+// [t0 - (n - l), t1 + (n - l)) of its rows (x taps reach one cell), step 1 reading box columns
+// t0 - n .. t1 + n - 1 of the input rows.
+void FusedSweep::sweep_tile(const std::vector<const double*>& in, const std::vector<double*>& out,
+                            int n, ExplicitRow row, RowFn fn, PetscInt t0, PetscInt t1) const {
   const Box& ob = grid_.owned();
-  const PetscInt W = frame_.width(), lx = frame_.lx(), ly = frame_.ly();
+  const PetscInt W = frame_.width(), lx = frame_.lx(), ly = frame_.ly(), mx = ob.m[0];
   const int nr = rows_.nrows;
   std::vector<const double*> src(static_cast<size_t>(ns_ * nr));
   std::vector<double*> dst(ns_);
@@ -92,6 +122,26 @@ void FusedSweep::run(const std::vector<const double*>& in, const std::vector<dou
   row.dst = dst.data();
   row.wclass = nullptr;
   auto margin = [&](int l) { return W - static_cast<PetscInt>(n - l) * r_; };
+  // Box columns [x0, x1) of row jl of step l; step 1 reads the input rows' `edge` or `mid` base.
+  auto sweep_row = [&](int l, PetscInt jl, PetscInt x0, PetscInt x1, bool mid) {
+    if (x1 <= x0) return;
+    for (int s = 0; s < ns_; ++s) {
+      const double* base = l == 1 ? nullptr : ring_row(l - 1, s, 0);
+      for (int q = 0; q < nr; ++q) {
+        const InputRow& in0 = in0_[s][slot[q]];
+        src[s * nr + q] =
+            (l == 1 ? (mid ? in0.mid : in0.edge) : base + slot[q] * static_cast<size_t>(stride_)) +
+            x0;
+      }
+      dst[s] = (l < n ? ring_row(l, s, jl)
+                      : out[s] + grid_.local_index(ob.s[0], ob.s[1] - W + jl, 0) - W) +
+               x0;
+    }
+    for (size_t q = 0; q < np; ++q)
+      prow[q] = pwide_[q].data() + (pfield_[q] ? jl * lx : 0) + x0;
+    row.n = static_cast<int>(x1 - x0);
+    fn(row);
+  };
   const PetscInt e0 = margin(0);
   for (PetscInt jw = e0; jw < ly - e0; ++jw) {
     for (int s = 0; s < ns_; ++s)
@@ -101,18 +151,16 @@ void FusedSweep::run(const std::vector<const double*>& in, const std::vector<dou
       if (jl < e || jl >= ly - e) continue;
       for (int q = 0; q < nr; ++q) // ring slot of each stencil row (one modulo per row)
         slot[q] = static_cast<size_t>((jl + rows_.off[q][0]) % ring_);
-      for (int s = 0; s < ns_; ++s) {
-        const double* base = l == 1 ? nullptr : ring_row(l - 1, s, 0);
-        for (int q = 0; q < nr; ++q)
-          src[s * nr + q] =
-              (l == 1 ? in0_[s][slot[q]] : base + slot[q] * static_cast<size_t>(stride_)) + e;
-        dst[s] = l < n ? ring_row(l, s, jl) + e
-                       : out[s] + grid_.local_index(ob.s[0], ob.s[1] - W + jl, 0);
+      const PetscInt a = t0 - (n - l), b = t1 + (n - l);
+      if (l > 1 || mx < kInPlaceMin) {
+        sweep_row(l, jl, a, b, false);
+        continue;
       }
-      for (size_t q = 0; q < np; ++q)
-        prow[q] = pwide_[q].data() + (pfield_[q] ? jl * lx : 0) + e;
-      row.n = static_cast<int>(lx - 2 * e);
-      fn(row);
+      // Step 1: the owned row in place between its second and second-last cell.
+      const PetscInt m0 = std::clamp(W + 1, a, b), m1 = std::clamp(W + mx - 1, m0, b);
+      sweep_row(1, jl, a, m0, false);
+      sweep_row(1, jl, m0, m1, true);
+      sweep_row(1, jl, m1, b, false);
     }
   }
 }

@@ -8,9 +8,9 @@
 // call; the owned cells are read in place. Box rows jw = 0 .. Ly-1 and columns iw = 0 .. Lx-1
 // (the owned box grown by W = k r). Step l (1..n) computes the box shrunk by
 // e_l = W - (n - l) r on each side, so step n yields exactly the owned box. Wavefront along y:
-// after input row jw is assembled (left strip, owned row, right strip), step l computes its row
-// jw - l r, whose neighbours rows jw - l r +- r of step l - 1 are ready. Each step keeps a ring
-// of 2r + 1 rows per species (2r + 1 rows of Lx cells per step and species stay in cache); the
+// after input row jw is ready (strips from the frame, the owned row read in place), step l computes
+// its row jw - l r, whose neighbours rows jw - l r +- r of step l - 1 are ready. Each step keeps a
+// ring of 2r + 1 rows per species (2r + 1 rows of Lx cells per step and species stay in cache); the
 // last step writes the owned row of the output arrays. Memory traffic per n steps: one read
 // and one write of the state, instead of n of each.
 // Per-cell parameters (field mode): each field is copied once into the wide box (WideHalo) and
@@ -31,7 +31,8 @@ public:
   using RowFn = void (*)(const ExplicitRow&);
   // Up to `depth` >= 1 steps per call of `nspecies` species with the 2-D row stencil `rows`
   // (one grid row per y offset rows.off[q][0]). Collective (builds the frame halo).
-  FusedSweep(const Grid& grid, const RowStencil& rows, int nspecies, int depth);
+  // tile: owned columns per tile (0: auto, ring rows within kTileBytes; see run).
+  FusedSweep(const Grid& grid, const RowStencil& rows, int nspecies, int depth, PetscInt tile = 0);
 
   // Field mode: the parameters of every cell of the wide box (fields fixed in time). Collective.
   void set_params(const ParamSet& params);
@@ -51,17 +52,28 @@ private:
     const size_t slot = static_cast<size_t>(jw % ring_);
     return ring_buf_.data() + ((static_cast<size_t>(level) * ns_ + s) * ring_ + slot) * stride_;
   }
-  const double* input_row(const std::vector<const double*>& in, int s, PetscInt jw) const;
+  struct InputRow {
+    const double* edge = nullptr; // box columns near the strips (or all of a frame row)
+    const double* mid = nullptr;  // owned columns 1 .. mx - 2 (the owned row, read in place)
+  };
+  static constexpr PetscInt kInPlaceMin = 64; // narrower owned rows are copied whole
+  InputRow input_row(const std::vector<const double*>& in, int s, PetscInt jw) const;
+  static constexpr double kTileBytes = 1024.0 * 1024; // ring rows of one tile: half an L2
+  PetscInt tile_width() const;
+  void sweep_tile(const std::vector<const double*>& in, const std::vector<double*>& out, int n,
+                  ExplicitRow row, RowFn fn, PetscInt t0, PetscInt t1) const;
 
   const Grid& grid_;
   RowStencil rows_;
-  int ns_, depth_, r_;
+  int ns_, depth_;
+  PetscInt tile_;
+  int r_;
   FrameHalo frame_;
-  PetscInt ring_;                                       // rows per ring: 2r + 1
-  PetscInt stride_;                                     // doubles per ring row
-  mutable std::vector<std::vector<double>> frame_buf_;  // per species
-  mutable std::vector<double> ring_buf_;                // [level][species][slot][stride]
-  mutable std::vector<std::vector<const double*>> in0_; // level 0 rows per species and slot
+  PetscInt ring_;                                      // rows per ring: 2r + 1
+  PetscInt stride_;                                    // doubles per ring row
+  mutable std::vector<std::vector<double>> frame_buf_; // per species
+  mutable std::vector<double> ring_buf_;               // [level][species][slot][stride]
+  mutable std::vector<std::vector<InputRow>> in0_;     // level 0 rows per species and slot
   std::vector<std::vector<double>> pwide_; // field mode: per parameter, Lx * Ly or Lx cells
   std::vector<bool> pfield_;               // parameter q is a field (else one row of Lx)
 };

@@ -2,7 +2,8 @@
 // passes of up to k fused steps (Simulation::advance) give bitwise the same state as N single
 // steps (Simulation::step), for k = 2, 3, 8, N not a multiple of k, passes of mixed lengths,
 // the 5- and 9-point stencils, Turing (scalar and per-cell parameters) and Gray-Scott, and a halo
-// wider than a neighbour's extent (k = 8 on a small grid). Compared with memcmp on rank 0; the
+// wider than a neighbour's extent (k = 8 on a small grid), owned rows read in place (wide rows).
+// Compared with memcmp on rank 0; the
 // verdict is reduced over all ranks. Unsupported configurations fall back to one step per pass.
 #include "../mpi_expect.hpp"
 #include "../sim_fixture.hpp"
@@ -91,6 +92,27 @@ TEST(FusedSteps, Turing9ptMixedPasses) {
 
 TEST(FusedSteps, GrayScott9ptK4) {
   EXPECT_TRUE(same_as_single_steps(gray_scott("40,40", "9pt"), 4, 43, {}));
+}
+
+// Owned rows of at least FusedSweep::kInPlaceMin cells (here 75 .. 300 on 1, 2 or 4 ranks) are
+// read in place by the first fused step, in three calls per row (strips, owned middle, strips);
+// rows split into tiles (-explicit_fuse_tile) give the same bits.
+TEST(FusedSteps, WideRowsReadInPlace) {
+  for (const char* st : {"9pt", "5pt"}) {
+    OptionList g = gray_scott("300,24", st);
+    g[2] = {"grid_L", "7.5,0.6"}; // equal spacings
+    EXPECT_TRUE(same_as_single_steps(g, st[0] == '9' ? 4 : 8, 23, {4, 3, 8, 5}));
+  }
+  for (const char* tile : {"50", "7"}) { // several tiles per row, also narrower than k
+    OptionList g = gray_scott("300,24", "9pt");
+    g[2] = {"grid_L", "7.5,0.6"};
+    g.push_back({"explicit_fuse_tile", tile});
+    EXPECT_TRUE(same_as_single_steps(g, 8, 19, {8, 3}));
+  }
+  OptionList o = kTuring;
+  o[0] = {"grid_n", "300,24"};
+  o[1] = {"params_alpha", "12 +- 0.1% gauss"};
+  EXPECT_TRUE(same_as_single_steps(o, 3, 20, {}));
 }
 
 TEST(FusedSteps, HaloWiderThanNeighbours) { // W = 8 cells, owned extents 6..12
