@@ -710,29 +710,45 @@ bool Simulation::all_constant_diffusion() const {
   return true;
 }
 
+namespace {
+
+// A run that blows up may stay finite for a long time (a checkerboard growing to 1e69): values
+// beyond the classifier's blow-up bound (analysis::kBlowupBound) count as diverged.
+constexpr double kBlowup = 1e10;
+
+// The first of n cells that is NaN, infinite or beyond kBlowup, or -1. The row is scanned with
+// an integer OR (vectorised), the cell found only when there is one.
+PetscInt first_diverged(const double* __restrict__ a, PetscInt n) {
+  int bad = 0;
+  for (PetscInt i = 0; i < n; ++i)
+    bad |= !(std::fabs(a[i]) <= kBlowup);
+  if (!bad) return -1;
+  for (PetscInt i = 0; i < n; ++i)
+    if (!(std::fabs(a[i]) <= kBlowup)) return i;
+  return -1;
+}
+
+} // namespace
+
 void Simulation::check_finite() const {
-  // A run that blows up may stay finite for a long time (a checkerboard growing to 1e69):
-  // values beyond the classifier's blow-up bound (analysis::kBlowupBound) count as diverged.
-  constexpr double kBlowup = 1e10;
   std::string err;
   const Box& ob = grid_->owned();
   for (size_t s = 0; s < u_.size() && err.empty(); ++s) {
     const PetscScalar* a;
     MG_PETSC(VecGetArrayRead(u_[s], &a));
     for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2] && err.empty(); ++k)
-      for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1] && err.empty(); ++j)
-        for (PetscInt i = ob.s[0]; i < ob.s[0] + ob.m[0]; ++i) {
-          const double v = a[grid_->local_index(i, j, k)];
-          if (!(std::fabs(v) <= kBlowup)) { // NaN, Inf or blown up
-            err = "species " + species_[s] + " became " + format_number(v) +
-                  (std::isfinite(v) ? " (over the blow-up bound 1e10)" : "") + " at cell (" +
-                  std::to_string(i) + "," + std::to_string(j) + "," + std::to_string(k) +
-                  ") by step " + std::to_string(step_) + " (t = " + format_number(t_) +
-                  "): the run diverged; reduce -dt" +
-                  (floor_[s] == 0.0 ? std::string() : std::string(" or try -clamp true"));
-            break;
-          }
-        }
+      for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1] && err.empty(); ++j) {
+        const double* row = a + grid_->local_index(ob.s[0], j, k);
+        const PetscInt x = first_diverged(row, ob.m[0]);
+        if (x < 0) continue;
+        const double v = row[x];
+        err = "species " + species_[s] + " became " + format_number(v) +
+              (std::isfinite(v) ? " (over the blow-up bound 1e10)" : "") + " at cell (" +
+              std::to_string(ob.s[0] + x) + "," + std::to_string(j) + "," + std::to_string(k) +
+              ") by step " + std::to_string(step_) + " (t = " + format_number(t_) +
+              "): the run diverged; reduce -dt" +
+              (floor_[s] == 0.0 ? std::string() : std::string(" or try -clamp true"));
+      }
     MG_PETSC(VecRestoreArrayRead(u_[s], &a));
   }
   throw_if_any(comm_, err);

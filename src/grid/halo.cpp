@@ -2,6 +2,8 @@
 
 #include <petscdmda.h>
 
+#include <cstring>
+
 namespace morphogen {
 
 namespace {
@@ -77,18 +79,38 @@ Halo::Halo(const Grid& grid) : grid_(grid) {
   MPI_Comm_size(grid.comm(), &size);
   local_only_ = size == 1;
   if (local_only_) {
-    ghost_ = leaves;
+    std::vector<PetscInt> source;
     for (const PetscSFNode& r : remotes)
-      source_.push_back(r.index);
+      source.push_back(r.index);
+    split_runs(leaves, source);
+  }
+}
+
+void Halo::split_runs(const std::vector<PetscInt>& ghost, const std::vector<PetscInt>& source) {
+  const size_t n = ghost.size();
+  for (size_t q = 0; q < n;) {
+    size_t e = q + 1;
+    while (e < n && ghost[e] == ghost[e - 1] + 1 && source[e] == source[e - 1] + 1)
+      ++e;
+    const PetscInt len = static_cast<PetscInt>(e - q);
+    if (len >= kMinRun) {
+      runs_.push_back({ghost[q], source[q], len});
+    } else {
+      ghost_.insert(ghost_.end(), ghost.begin() + q, ghost.begin() + e);
+      source_.insert(source_.end(), source.begin() + q, source.begin() + e);
+    }
+    q = e;
   }
 }
 
 void Halo::begin(double* a) const {
-  if (local_only_) {
+  if (local_only_) { // sources are owned cells: order does not matter
+    for (const Run& r : runs_)
+      std::memcpy(a + r.ghost, a + r.source, sizeof(double) * r.len);
     const PetscInt n = static_cast<PetscInt>(ghost_.size());
     const PetscInt* __restrict__ g = ghost_.data();
     const PetscInt* __restrict__ s = source_.data();
-    for (PetscInt q = 0; q < n; ++q) // sources are owned cells: order does not matter
+    for (PetscInt q = 0; q < n; ++q)
       a[g[q]] = a[s[q]];
     return;
   }

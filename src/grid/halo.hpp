@@ -55,9 +55,16 @@ private:
   const Grid& grid_;
   SFH sf_;
   // On a one-rank communicator (a sweep point, a serial run) the periodic ghosts are copied
-  // directly, ghost_[q] <- source_[q], without PetscSF's pack/unpack and call overhead (a
-  // quarter of a 64^2 explicit step).
+  // directly, without PetscSF's pack/unpack and call overhead (a quarter of a 64^2 explicit
+  // step): runs of at least kMinRun consecutive ghosts with consecutive sources (whole ghost
+  // rows) as block copies, the other ghosts one by one, ghost_[q] <- source_[q].
+  struct Run {
+    PetscInt ghost, source, len;
+  };
+  static constexpr PetscInt kMinRun = 8;
+  void split_runs(const std::vector<PetscInt>& ghost, const std::vector<PetscInt>& source);
   bool local_only_ = false;
+  std::vector<Run> runs_;
   std::vector<PetscInt> ghost_, source_;
 };
 
