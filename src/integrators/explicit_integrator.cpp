@@ -57,8 +57,13 @@ void ExplicitIntegrator::step_general(std::vector<VecH>& u, std::vector<VecH>& w
                                       double dt) const {
   LogScope log_scope(log_events().sweep);
   const int np = static_cast<int>(params_.scalar.size());
-  std::vector<const PetscScalar*> in(ns_), pf(np, nullptr);
-  std::vector<PetscScalar*> out(ns_);
+  SweepTables& tb = tab_; // reused between steps (no allocation per step)
+  auto& in = tb.cin;
+  auto& pf = tb.pf;
+  auto& out = tb.out;
+  in.assign(static_cast<size_t>(ns_), nullptr);
+  pf.assign(static_cast<size_t>(np), nullptr);
+  out.assign(static_cast<size_t>(ns_), nullptr);
   for (int s = 0; s < ns_; ++s) {
     MG_PETSC(VecGetArrayRead(u[s], &in[s]));
     MG_PETSC(VecGetArray(work[s], &out[s]));
@@ -66,8 +71,14 @@ void ExplicitIntegrator::step_general(std::vector<VecH>& u, std::vector<VecH>& w
   for (int q = 0; q < np; ++q)
     if (params_.field[q].get()) MG_PETSC(VecGetArrayRead(params_.field[q], &pf[q]));
   const Box& ob = grid_.owned();
-  std::vector<const double*> src(ns_), div(ns_), prow(np, nullptr);
-  std::vector<double*> dst(ns_);
+  auto& src = tb.src;
+  auto& div = tb.div;
+  auto& prow = tb.prow;
+  auto& dst = tb.dst;
+  src.assign(static_cast<size_t>(ns_), nullptr);
+  div.assign(static_cast<size_t>(ns_), nullptr);
+  prow.assign(static_cast<size_t>(np), nullptr);
+  dst.assign(static_cast<size_t>(ns_), nullptr);
   for (int s = 0; s < ns_; ++s)
     div[s] = div_[s].data();
   ExplicitRow row;

@@ -151,7 +151,7 @@ private:
     std::vector<PetscScalar*> in, out;
     std::vector<const PetscScalar*> pf;
     std::vector<PetscInt> delta, dy, dz;
-    std::vector<const double*> src, prow;
+    std::vector<const double*> src, prow, div, cin; // cin, div: the general path
     std::vector<double*> dst;
   };
   mutable SweepTables tab_;
