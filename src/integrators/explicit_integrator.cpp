@@ -61,9 +61,7 @@ void ExplicitIntegrator::step_general(std::vector<VecH>& u, std::vector<VecH>& w
   auto& in = tb.cin;
   auto& pf = tb.pf;
   auto& out = tb.out;
-  in.assign(static_cast<size_t>(ns_), nullptr);
-  pf.assign(static_cast<size_t>(np), nullptr);
-  out.assign(static_cast<size_t>(ns_), nullptr);
+  tb.reset(static_cast<size_t>(ns_), static_cast<size_t>(np), 1);
   for (int s = 0; s < ns_; ++s) {
     MG_PETSC(VecGetArrayRead(u[s], &in[s]));
     MG_PETSC(VecGetArray(work[s], &out[s]));
@@ -75,10 +73,6 @@ void ExplicitIntegrator::step_general(std::vector<VecH>& u, std::vector<VecH>& w
   auto& div = tb.div;
   auto& prow = tb.prow;
   auto& dst = tb.dst;
-  src.assign(static_cast<size_t>(ns_), nullptr);
-  div.assign(static_cast<size_t>(ns_), nullptr);
-  prow.assign(static_cast<size_t>(np), nullptr);
-  dst.assign(static_cast<size_t>(ns_), nullptr);
   for (int s = 0; s < ns_; ++s)
     div[s] = div_[s].data();
   ExplicitRow row;
@@ -299,9 +293,7 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
   auto& in = tb.in;
   auto& out = tb.out;
   auto& pf = tb.pf;
-  in.assign(static_cast<size_t>(ns_), nullptr);
-  out.assign(static_cast<size_t>(ns_), nullptr);
-  pf.assign(static_cast<size_t>(np), nullptr);
+  tb.reset(static_cast<size_t>(ns_), static_cast<size_t>(np), static_cast<size_t>(nr));
   for (int s = 0; s < ns_; ++s) {
     MG_PETSC(VecGetArray(u[s], &in[s]));
     if (!in_place) MG_PETSC(VecGetArray((*work)[s], &out[s]));
@@ -326,9 +318,6 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
   auto& src = tb.src;
   auto& dst = tb.dst;
   auto& prow = tb.prow;
-  src.assign(static_cast<size_t>(ns_ * nr), nullptr);
-  dst.assign(static_cast<size_t>(ns_), nullptr);
-  prow.assign(static_cast<size_t>(np), nullptr);
   ExplicitRow row;
   row.n = static_cast<int>(ob.m[0]);
   row.src = src.data();

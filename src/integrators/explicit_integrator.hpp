@@ -153,6 +153,16 @@ private:
     std::vector<PetscInt> delta, dy, dz;
     std::vector<const double*> src, prow, div, cin; // cin, div: the general path
     std::vector<double*> dst;
+    // Every table sized for ns species, np parameters and nr stencil rows, entries null.
+    void reset(size_t ns, size_t np, size_t nr) {
+      for (auto* v : {&in, &out, &dst})
+        v->assign(ns, nullptr);
+      for (auto* v : {&cin, &div})
+        v->assign(ns, nullptr);
+      pf.assign(np, nullptr);
+      prow.assign(np, nullptr);
+      src.assign(ns * nr, nullptr);
+    }
   };
   mutable SweepTables tab_;
   size_t ring_n_ = 0; // owned cells per row
