@@ -113,6 +113,8 @@ TEST(FusedSteps, WideRowsReadInPlace) {
   o[0] = {"grid_n", "300,24"};
   o[1] = {"params_alpha", "12 +- 0.1% gauss"};
   EXPECT_TRUE(same_as_single_steps(o, 3, 20, {}));
+  o.push_back({"explicit_fuse_tile", "40"}); // per-cell parameters read per tile
+  EXPECT_TRUE(same_as_single_steps(o, 3, 20, {}));
 }
 
 TEST(FusedSteps, HaloWiderThanNeighbours) { // W = 8 cells, owned extents 6..12
