@@ -56,7 +56,9 @@ private:
     const double* edge = nullptr; // box columns near the strips (or all of a frame row)
     const double* mid = nullptr;  // owned columns 1 .. mx - 2 (the owned row, read in place)
   };
-  static constexpr PetscInt kInPlaceMin = 64; // narrower owned rows are copied whole
+  // Narrower owned rows are copied whole: one kernel call per row (at 64 cells three calls cost
+  // more than the copy saves).
+  static constexpr PetscInt kInPlaceMin = 512;
   InputRow input_row(const std::vector<const double*>& in, int s, PetscInt jw) const;
   static constexpr double kTileBytes = 1024.0 * 1024; // ring rows of one tile: half an L2
   PetscInt tile_width() const;

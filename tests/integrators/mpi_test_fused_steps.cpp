@@ -94,23 +94,23 @@ TEST(FusedSteps, GrayScott9ptK4) {
   EXPECT_TRUE(same_as_single_steps(gray_scott("40,40", "9pt"), 4, 43, {}));
 }
 
-// Owned rows of at least FusedSweep::kInPlaceMin cells (here 75 .. 300 on 1, 2 or 4 ranks) are
+// Owned rows of at least FusedSweep::kInPlaceMin cells (here 512 .. 2048 on 1, 2 or 4 ranks) are
 // read in place by the first fused step, in three calls per row (strips, owned middle, strips);
 // rows split into tiles (-explicit_fuse_tile) give the same bits.
 TEST(FusedSteps, WideRowsReadInPlace) {
   for (const char* st : {"9pt", "5pt"}) {
-    OptionList g = gray_scott("300,24", st);
-    g[2] = {"grid_L", "7.5,0.6"}; // equal spacings
+    OptionList g = gray_scott("2048,24", st);
+    g[2] = {"grid_L", "51.2,0.6"}; // equal spacings
     EXPECT_TRUE(same_as_single_steps(g, st[0] == '9' ? 4 : 8, 23, {4, 3, 8, 5}));
   }
   for (const char* tile : {"50", "7"}) { // several tiles per row, also narrower than k
-    OptionList g = gray_scott("300,24", "9pt");
-    g[2] = {"grid_L", "7.5,0.6"};
+    OptionList g = gray_scott("2048,24", "9pt");
+    g[2] = {"grid_L", "51.2,0.6"};
     g.push_back({"explicit_fuse_tile", tile});
     EXPECT_TRUE(same_as_single_steps(g, 8, 19, {8, 3}));
   }
   OptionList o = kTuring;
-  o[0] = {"grid_n", "300,24"};
+  o[0] = {"grid_n", "2048,24"};
   o[1] = {"params_alpha", "12 +- 0.1% gauss"};
   EXPECT_TRUE(same_as_single_steps(o, 3, 20, {}));
   o.push_back({"explicit_fuse_tile", "40"}); // per-cell parameters read per tile
