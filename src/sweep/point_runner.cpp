@@ -61,13 +61,19 @@ nlohmann::json run_point_impl(const SweepSpec& spec, long long p, const SweepSet
   std::string diverged;
   const PetscInt nan_every = sim.output().nan_check_every;
   sampler.take(sim);
-  // Passes of up to fuse_steps() steps (-explicit_fuse_steps), each ending at the next sample
-  // or NaN check: bitwise the results of single steps.
+  // Passes of up to kPassSteps steps (or one fused pass), each ending at the next sample or NaN
+  // check, in advances of up to fuse_steps() steps (-explicit_fuse_steps): bitwise the results
+  // of single steps. The work queue is served and the stop signal checked once per pass.
+  constexpr PetscInt kPassSteps = 32;
+  const PetscInt pass = std::max(kPassSteps, sim.fuse_steps());
   for (PetscInt n = 0; n < steps && diverged.empty();) {
-    const PetscInt k =
-        std::min({sim.fuse_steps(), steps - n, every - n % every, nan_every - n % nan_every});
+    const PetscInt k = std::min({pass, steps - n, every - n % every, nan_every - n % nan_every});
     try {
-      sim.advance(k);
+      for (PetscInt done = 0; done < k;) {
+        const PetscInt c = std::min(sim.fuse_steps(), k - done);
+        sim.advance(c);
+        done += c;
+      }
       n += k;
       if (n % nan_every == 0 || n == steps) sim.check_finite();
     } catch (const UserError& e) {
