@@ -366,8 +366,9 @@ int run_sweep(int* argc, char*** argv, const std::vector<OptionsFileArg>& option
   MPI_Allreduce(MPI_IN_PLACE, &any_interrupted, 1, MPI_INT, MPI_LOR, world);
   int cut = q.cut_by_deadline();
   MPI_Bcast(&cut, 1, MPI_INT, 0, world);
+  nlohmann::json map = stability_map(s.spec, s.set.base_dir, world);
   if (rank == 0) {
-    const std::string terr = write_sweep_table(dir, s.spec, yaml, s.set.base_dir);
+    const std::string terr = write_sweep_table(dir, s.spec, yaml, std::move(map));
     if (!terr.empty()) {
       std::fprintf(stderr, "morphogen: error: %s\n", terr.c_str());
       MPI_Abort(world, 4);

@@ -3,6 +3,8 @@
 #include "analysis/linear_stability.hpp"
 #include "app/pattern_summary.hpp"
 #include "app/simulation.hpp"
+#include "core/collective_error.hpp"
+#include "core/user_error.hpp"
 #include "io/series_index.hpp"
 #include "sweep/point_record.hpp"
 #include "sweep/point_runner.hpp"
@@ -13,6 +15,7 @@
 #include <fcntl.h>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <sys/file.h>
 #include <unistd.h>
 
@@ -48,27 +51,40 @@ bool past_hopf(const analysis::StabilityResult& st) {
   return tr > st.tol && det > 0;
 }
 
-// Linear stability over a refined grid of the axes (empty for a listed sweep, when an axis is
-// not a model parameter or diffusion coefficient, or when a parameter varies in space).
-nlohmann::json stability_map(const SweepSpec& spec, const std::string& base_dir) {
-  if (spec.listed) return {};
+// What the stability map varies: the model, the base parameters and diffusion coefficients, the
+// entry each axis sets, the options of the analysis and the refined axes.
+struct MapSetup {
+  std::unique_ptr<Simulation> sim; // owns the model entry
+  std::vector<double> params, D;
+  std::vector<double*> target;
+  analysis::StabilityOptions so;
+  std::vector<std::vector<double>> axes;
+  size_t total = 1;
+};
+
+// The map's setup, or null when there is no map: a listed sweep, an axis that is not a model
+// parameter or diffusion coefficient, a parameter that varies in space, or over 40,000 points.
+std::unique_ptr<MapSetup> map_setup(const SweepSpec& spec, const std::string& base_dir) {
+  if (spec.listed) return nullptr;
   // The base configuration: the options database holds the deck plus the last point's values.
   Options opt(PETSC_COMM_SELF);
   for (const auto& a : spec.axes)
     MG_PETSC(PetscOptionsSetValue(nullptr, ("-" + a.option).c_str(), a.values[0].c_str()));
-  Simulation sim(PETSC_COMM_SELF, opt, base_dir);
-  if (sim.params().any_field()) return {};
+  auto ms = std::make_unique<MapSetup>();
+  ms->sim = std::make_unique<Simulation>(PETSC_COMM_SELF, opt, base_dir);
+  const Simulation& sim = *ms->sim;
+  if (sim.params().any_field()) return nullptr;
   const ModelEntry& m = sim.model();
-  std::vector<double> params = sim.params().scalar, D = sim.diffusion();
-  std::vector<double*> target;
+  ms->params = sim.params().scalar;
+  ms->D = sim.diffusion();
   for (const auto& a : spec.axes) {
     double* t = nullptr;
     for (int q = 0; q < m.nparams; ++q)
-      if (a.option == std::string("params_") + m.params[q].name) t = &params[q];
+      if (a.option == std::string("params_") + m.params[q].name) t = &ms->params[q];
     for (int s = 0; s < m.nspecies; ++s)
-      if (a.option == std::string("D_") + m.species[s].name) t = &D[s];
-    if (!t) return {};
-    target.push_back(t);
+      if (a.option == std::string("D_") + m.species[s].name) t = &ms->D[s];
+    if (!t) return nullptr;
+    ms->target.push_back(t);
   }
   analysis::DiscreteGrid dg;
   const auto& g = sim.grid().spec();
@@ -79,57 +95,79 @@ nlohmann::json stability_map(const SweepSpec& spec, const std::string& base_dir)
     dg.periodic[d] = g.bc[d] == Boundary::Periodic;
   }
   dg.stencil = sim.stencil().name;
-  analysis::StabilityOptions so;
-  so.grid = dg;
-  so.samples = 256;
+  ms->so.grid = dg;
+  ms->so.samples = 256;
   const int refine = spec.points() > 4096 ? 1 : 4;
-  std::vector<std::vector<double>> axes;
-  size_t total = 1;
   for (const auto& a : spec.axes) {
-    axes.push_back(refined(a.numbers, refine));
-    total *= axes.back().size();
+    ms->axes.push_back(refined(a.numbers, refine));
+    ms->total *= ms->axes.back().size();
   }
-  if (total > 40000) return {};
+  return ms->total > 40000 ? nullptr : std::move(ms);
+}
+
+// Point p of the map: Turing-unstable, Hopf, past the Hopf line (1 or 0) and the fastest
+// wavelength (NaN: none) into out[0..3]; a point whose analysis fails is 0, 0, 0, NaN.
+void map_point(MapSetup& ms, size_t p, double* out) {
+  size_t r = p;
+  for (size_t a = 0; a < ms.axes.size(); ++a) {
+    *ms.target[a] = ms.axes[a][r % ms.axes[a].size()];
+    r /= ms.axes[a].size();
+  }
+  out[0] = out[1] = out[2] = 0;
+  out[3] = std::nan("");
+  try {
+    const auto st = analyse_states(ms.sim->model(), ms.params, ms.D, ms.so, nullptr);
+    out[0] = st.turing_unstable;
+    out[1] = st.hopf;
+    out[2] = past_hopf(st);
+    if (st.turing_unstable && std::isfinite(st.wavelength_fastest)) out[3] = st.wavelength_fastest;
+  } catch (const std::exception&) {
+  }
+}
+
+} // namespace
+
+nlohmann::json stability_map(const SweepSpec& spec, const std::string& base_dir, MPI_Comm comm) {
+  std::unique_ptr<MapSetup> ms;
+  std::string err;
+  try {
+    ms = map_setup(spec, base_dir);
+  } catch (const std::exception& e) {
+    err = e.what();
+  }
+  try {
+    throw_if_any(comm, err);
+  } catch (const UserError& e) {
+    return {{"error", e.what()}};
+  }
+  if (!ms) return {}; // the same on every rank: the setup depends on the spec and deck only
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  // Point p on rank p mod size, zeros elsewhere: the sum on rank 0 is each point's own values.
+  std::vector<double> v(4 * ms->total, 0.0);
+  for (size_t p = static_cast<size_t>(rank); p < ms->total; p += static_cast<size_t>(size))
+    map_point(*ms, p, &v[4 * p]);
+  MPI_Reduce(rank == 0 ? MPI_IN_PLACE : v.data(), v.data(), static_cast<int>(v.size()), MPI_DOUBLE,
+             MPI_SUM, 0, comm);
+  if (rank != 0) return {};
   nlohmann::json turing = nlohmann::json::array(), hopf = nlohmann::json::array(),
                  hopf_region = nlohmann::json::array(), wl = nlohmann::json::array();
-  for (size_t p = 0; p < total; ++p) {
-    size_t r = p;
-    for (size_t a = 0; a < axes.size(); ++a) {
-      *target[a] = axes[a][r % axes[a].size()];
-      r /= axes[a].size();
-    }
-    try {
-      const auto st = analyse_states(m, params, D, so, nullptr);
-      turing.push_back(st.turing_unstable);
-      hopf.push_back(st.hopf);
-      hopf_region.push_back(past_hopf(st));
-      wl.push_back(st.turing_unstable && std::isfinite(st.wavelength_fastest)
-                       ? nlohmann::json(st.wavelength_fastest)
-                       : nlohmann::json());
-    } catch (const std::exception&) {
-      turing.push_back(false);
-      hopf.push_back(false);
-      hopf_region.push_back(false);
-      wl.push_back(nullptr);
-    }
+  for (size_t p = 0; p < ms->total; ++p) {
+    turing.push_back(v[4 * p] != 0);
+    hopf.push_back(v[4 * p + 1] != 0);
+    hopf_region.push_back(v[4 * p + 2] != 0);
+    wl.push_back(std::isnan(v[4 * p + 3]) ? nlohmann::json() : nlohmann::json(v[4 * p + 3]));
   }
-  return {{"axes", axes},
+  return {{"axes", ms->axes},
           {"turing", turing},
           {"hopf", hopf},
           {"hopf_region", hopf_region},
           {"wavelength", wl}};
 }
 
-} // namespace
-
 std::string write_sweep_table(const std::string& dir, const SweepSpec& spec,
-                              const std::string& base_options, const std::string& base_dir) {
-  nlohmann::json map;
-  try {
-    map = stability_map(spec, base_dir);
-  } catch (const std::exception& e) {
-    map = {{"error", e.what()}};
-  }
+                              const std::string& base_options, nlohmann::json map) {
   // Chunks sharing the directory: scan and write under a lock, so the newest scan wins and
   // sweep.csv and sweep.json come from the same scan.
   const int lock = open((dir + "/.sweep.lock").c_str(), O_CREAT | O_RDWR, 0644);

@@ -12,14 +12,22 @@
 
 #include "sweep/sweep_spec.hpp"
 
+#include <mpi.h>
+#include <nlohmann/json.hpp>
+
 #include <string>
 
 namespace morphogen::sweep {
 
+// The stability map of sweep.json (above; null when there is none, {"error": ...} when its set-up
+// fails). Collective on comm: the points are shared among its ranks; the map is returned on
+// rank 0 (null elsewhere). base_dir: the deck's directory (relative file names in values).
+nlohmann::json stability_map(const SweepSpec& spec, const std::string& base_dir, MPI_Comm comm);
+
 // Returns "" or the error. base_options: the first point's options as YAML (for the record);
-// base_dir: the deck's directory (relative file names in values). Chunks writing at the same
-// time serialise on dir/.sweep.lock (flock).
+// map: stability_map's result. Chunks writing at the same time serialise on dir/.sweep.lock
+// (flock).
 std::string write_sweep_table(const std::string& dir, const SweepSpec& spec,
-                              const std::string& base_options, const std::string& base_dir);
+                              const std::string& base_options, nlohmann::json map);
 
 } // namespace morphogen::sweep

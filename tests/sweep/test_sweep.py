@@ -1,8 +1,8 @@
 """`morphogen sweep`, end to end on 1 and 2 ranks: a Gray-Scott F x k sweep (16 x 16 points of a
 small grid) finishes and writes a table of every point with a class; a sweep stopped halfway
 (SIGUSR1: exit 3; or killed outright) resumes without redoing finished points; chunks for job
-arrays cover the sweep exactly once; results do not depend on the rank-group layout; bad sweep
-input is refused with one line."""
+arrays cover the sweep exactly once; results (and the stability map, computed by all ranks) do not
+depend on the rank-group layout; bad sweep input is refused with one line."""
 import os
 import signal
 import subprocess
@@ -105,6 +105,11 @@ def test_group_layout_does_not_change_results(tmp_path):
         assert a[i]["class"] == b[i]["class"]
         assert a[i]["metrics"]["mean"] == pytest.approx(b[i]["metrics"]["mean"], rel=1e-12)
         assert b[i]["ranks"] == 2 and a[i]["ranks"] == 1
+    # The stability map's points are shared among the ranks: the same map as on one rank.
+    ok(run(base + ["-output_dir", "r1"], tmp_path, 1))
+    maps = [table(tmp_path / d)["stability_map"] for d in ("g1", "g2", "r1")]
+    assert len(maps[2]["hopf"]) == 25 and 0 < sum(maps[2]["hopf"]) < 25
+    assert maps[0] == maps[2] and maps[1] == maps[2]
 
 
 @pytest.mark.parametrize("args,needle", [
