@@ -256,6 +256,7 @@ analysis::StabilityResult analyse_states(const ModelEntry& model, const std::vec
                                          const std::vector<double>& D,
                                          const analysis::StabilityOptions& so, int* states) {
   analysis::StabilityResult own = analysis::analyse(model, params, D, so);
+  if (own.turing_unstable && !states) return own; // the search would not change the answer
   const auto all = analysis::find_steady_states(model, params);
   if (states) *states = static_cast<int>(all.size());
   std::optional<analysis::StabilityResult> hopf;
