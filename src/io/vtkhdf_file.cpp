@@ -299,6 +299,18 @@ bool one_rank(MPI_Comm comm) {
   return size == 1;
 }
 
+// A new file for one rank's POSIX driver, without HDF5's file lock (as the MPI-IO path: file
+// systems mounted without flock, as some Lustre sites, would refuse it); negative on failure.
+hid_t create_serial(const std::string& path) {
+  const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+  if (fapl < 0) return -1;
+  hid_t f = -1;
+  if (H5Pset_file_locking(fapl, false, true) >= 0)
+    f = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+  H5Pclose(fapl);
+  return f;
+}
+
 // A transfer property list for collective MPI-IO (every rank takes part in every dataset's
 // write or read), or the default one for a file of one rank's POSIX driver; negative on failure.
 hid_t collective_xfer(bool mpio = true) {
@@ -371,9 +383,7 @@ PetscErrorCode VtkHdfIO::write_impl(const std::string& path, const std::vector<s
   // 1.5 ms, which a sweep of small runs would pay per point. Else PETSc's viewer, collective.
   PetscViewer v = nullptr;
   const bool one = one_rank(grid_.comm());
-  H5Id serial(one ? H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT)
-                  : H5I_INVALID_HID,
-              H5Fclose);
+  H5Id serial(one ? create_serial(path) : H5I_INVALID_HID, H5Fclose);
   hid_t file = serial.id, vtk, mg;
   if (one) {
     MG_H5(file);
