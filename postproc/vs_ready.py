@@ -6,11 +6,15 @@
         [--opencl-platform P] [--opencl-device D] [--morphogen build/morphogen]
         [--mpiexec mpiexec] [--workdir DIR] [--json FILE]
 
-Both codes run the same explicit Gray-Scott problem in double precision on a periodic grid of
+Both codes run the same explicit Gray-Scott equations in double precision on a periodic grid of
 unit spacing: Ready's formula rule (its own example's kinetics: D 0.082 and 0.041, F 0.035,
 K 0.064, timestep 1) with its default "medium" Laplacian, the 9-point Mehrstellen stencil in
 2-D and the 27-point stencil in 3-D; morphogen's gray_scott model (the same equations, species
-roles swapped) with -stencil 9pt or 27pt on `--ranks` MPI ranks. Ready's command-line utility
+roles swapped) with -stencil 9pt or 27pt on `--ranks` MPI ranks. Both start from the substrate
+at 1 with the autocatalyst in the central 20 % of each axis (Ready: white noise there, its own
+example's seed; morphogen: 0.5). N must be a multiple of 4 (Ready updates blocks of 4 cells).
+Ready runs on OpenCL platform/device `--opencl-platform`/`--opencl-device` (its default 0/0;
+printed with the results: a GPU there is not a like-for-like comparison with CPU ranks). Ready's command-line utility
 runs `rdy -i CASE.vti -n N` (N iterations, no output file); morphogen runs `-steps N`.
 Each code is timed at two step counts N1 and N2 = N1 + N (N of about `--updates` cell-updates,
 best of `--repeat` runs each), so start-up, OpenCL compilation, set-up and final output cancel:
@@ -80,8 +84,8 @@ def parse_case(text):
         dim, n = {"2d": 2, "3d": 3}[dim.lower()], int(n)
     except (ValueError, KeyError):
         raise Failure(f"--cases {text}: expected 2d:N or 3d:N (N cells per axis)")
-    if n < 8:
-        raise Failure(f"--cases {text}: N must be at least 8")
+    if n < 8 or n % 4:
+        raise Failure(f"--cases {text}: N must be a multiple of 4, at least 8 (Ready's blocks)")
     return dim, n
 
 
@@ -101,7 +105,7 @@ def write_ready_file(path, dim, n):
 def morphogen_command(args, dim, n, steps, out_dir):
     """morphogen's run of the case (gray_scott: a the autocatalyst = Ready's b)."""
     grid = ",".join([str(n)] * dim)
-    square = "square(Lx/2, Ly/2, Lx/10)"
+    square = "square(Lx/2, Ly/2, Lx/10)" + ("*(abs(z - Lz/2) <= Lz/10)" if dim == 3 else "")
     cmd = [args.morphogen, "-model", "gray_scott", "-grid_n", grid, "-grid_L", grid,
            "-stencil", "9pt" if dim == 2 else "27pt", "-D_a", "0.041", "-D_b", "0.082",
            "-params_F", "0.035", "-params_k", "0.064", "-dt", "1", "-steps", str(steps),
@@ -119,9 +123,18 @@ def timed(cmd, what, cwd):
         raise Failure(f"{what}: cannot run {cmd[0]} ({e.strerror})")
     seconds = time.perf_counter() - t0
     if r.returncode != 0:
-        tail = (r.stderr.strip() or r.stdout.strip() or "no output").splitlines()[-1]
-        raise Failure(f"{what} exited with code {r.returncode}: {tail}")
+        raise Failure(f"{what} exited with code {r.returncode}: {reason(r.stdout, r.stderr)}")
     return seconds
+
+
+def reason(stdout, stderr):
+    """The line that says why a run failed: the first naming an error (morphogen writes
+    "morphogen: error: ..." to stderr, rdy its errors to stdout), else the last line."""
+    lines = [l.strip() for l in (stderr + "\n" + stdout).splitlines() if l.strip()]
+    for l in lines:
+        if "error" in l.lower() and not l.startswith("--"):
+            return l
+    return lines[-1] if lines else "no output"
 
 
 def rate(make_cmd, cells, n1, n2, repeat, what, cwd):
@@ -153,7 +166,8 @@ def compare_case(args, dim, n, work):
                    args.repeat, "morphogen", work)
     return {"case": f"{dim}d:{n}", "stencil": "9pt" if dim == 2 else "27pt", "cells": cells,
             "steps": [n1, n2], "ranks": args.ranks, "morphogen": r_morph, "ready": r_ready,
-            "ratio": r_morph / r_ready, "target": TARGET}
+            "ratio": r_morph / r_ready, "target": TARGET,
+            "opencl": [args.opencl_platform or 0, args.opencl_device or 0]}
 
 
 def parse_args(argv):
@@ -184,6 +198,8 @@ def main(argv):
         with tempfile.TemporaryDirectory() as tmp:
             work = os.path.abspath(args.workdir or tmp)
             os.makedirs(work, exist_ok=True)
+            print(f"morphogen on {args.ranks} rank(s); Ready on OpenCL platform "
+                  f"{args.opencl_platform or 0}, device {args.opencl_device or 0}; Mcell-updates/s")
             print(f"{'case':10} {'stencil':7} {'morphogen':>12} {'Ready':>12} {'ratio':>6}  target",
                   flush=True)
             results = []

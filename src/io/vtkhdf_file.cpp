@@ -300,12 +300,14 @@ bool one_rank(MPI_Comm comm) {
 }
 
 // A new file for one rank's POSIX driver, without HDF5's file lock (as the MPI-IO path: file
-// systems mounted without flock, as some Lustre sites, would refuse it); negative on failure.
+// systems mounted without flock, as some Lustre sites, would refuse it), whose close also closes
+// any object an error path left open; negative on failure.
 hid_t create_serial(const std::string& path) {
   const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
   if (fapl < 0) return -1;
   hid_t f = -1;
-  if (H5Pset_file_locking(fapl, false, true) >= 0)
+  if (H5Pset_file_locking(fapl, false, true) >= 0 &&
+      H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG) >= 0)
     f = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
   H5Pclose(fapl);
   return f;
@@ -430,8 +432,9 @@ PetscErrorCode VtkHdfIO::write_impl(const std::string& path, const std::vector<s
   MG_H5(H5Gclose(mg));
   if (v) PetscCall(PetscViewerDestroy(&v));
   if (one) {
-    MG_H5(H5Fclose(serial.id));
+    const hid_t f = serial.id;
     serial.id = H5I_INVALID_HID;
+    MG_H5(H5Fclose(f));
   }
   PetscFunctionReturn(0);
 }

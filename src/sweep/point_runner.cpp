@@ -35,6 +35,47 @@ nlohmann::json record_head(const SweepSpec& spec, long long p) {
   return r;
 }
 
+// A point's time loop after its first sample: passes each ending at the next sample (every
+// `every` steps) or NaN check, in advances of up to fuse_steps() steps (-explicit_fuse_steps), so
+// bitwise the results of single steps. After each pass the work queue is served and the group
+// agrees on the stop signal and on the pass's wall time: the next pass holds twice as many
+// advances while passes take under 1 ms (up to kMaxAdvances), half as many over 5 ms, so the
+// queue is answered within milliseconds however cheap or costly a step is. A diverged run (the
+// class blowup) sets `diverged`. Returns false when stopped by a signal.
+bool run_passes(Simulation& sim, FieldSampler& sampler, PetscInt every, WorkQueue& q, MPI_Comm comm,
+                std::string& diverged) {
+  constexpr PetscInt kMaxAdvances = 32;
+  const PetscInt steps = sim.steps(), nan_every = sim.output().nan_check_every;
+  const PetscInt fuse = sim.fuse_steps();
+  PetscInt advances = 1;
+  for (PetscInt n = 0; n < steps && diverged.empty();) {
+    const PetscInt k =
+        std::min({advances * fuse, steps - n, every - n % every, nan_every - n % nan_every});
+    const double t0 = MPI_Wtime();
+    try {
+      for (PetscInt done = 0; done < k;) {
+        const PetscInt c = std::min(fuse, k - done);
+        sim.advance(c);
+        done += c;
+      }
+      n += k;
+      if (n % nan_every == 0 || n == steps) sim.check_finite();
+    } catch (const UserError& e) {
+      diverged = e.what();
+    }
+    q.poll();
+    double agreed[2] = {stop_signal_received() != 0 ? 1.0 : 0.0, MPI_Wtime() - t0};
+    MPI_Allreduce(MPI_IN_PLACE, agreed, 2, MPI_DOUBLE, MPI_MAX, comm);
+    if (agreed[0] != 0) return false;
+    if (agreed[1] < 1e-3 && advances < kMaxAdvances)
+      advances *= 2;
+    else if (agreed[1] > 5e-3 && advances > 1)
+      advances /= 2;
+    if (diverged.empty() && (n % every == 0 || n == steps)) sampler.take(sim);
+  }
+  return true;
+}
+
 nlohmann::json run_point_impl(const SweepSpec& spec, long long p, const SweepSettings& set,
                               WorkQueue& q, bool& interrupted) {
   MPI_Comm comm = q.group();
@@ -59,34 +100,10 @@ nlohmann::json run_point_impl(const SweepSpec& spec, long long p, const SweepSet
   const PetscInt steps = sim.steps();
   const PetscInt every = std::max<PetscInt>(1, steps / std::max<long long>(1, set.samples));
   std::string diverged;
-  const PetscInt nan_every = sim.output().nan_check_every;
   sampler.take(sim);
-  // Passes of up to kPassSteps steps (or one fused pass), each ending at the next sample or NaN
-  // check, in advances of up to fuse_steps() steps (-explicit_fuse_steps): bitwise the results
-  // of single steps. The work queue is served and the stop signal checked once per pass.
-  constexpr PetscInt kPassSteps = 32;
-  const PetscInt pass = std::max(kPassSteps, sim.fuse_steps());
-  for (PetscInt n = 0; n < steps && diverged.empty();) {
-    const PetscInt k = std::min({pass, steps - n, every - n % every, nan_every - n % nan_every});
-    try {
-      for (PetscInt done = 0; done < k;) {
-        const PetscInt c = std::min(sim.fuse_steps(), k - done);
-        sim.advance(c);
-        done += c;
-      }
-      n += k;
-      if (n % nan_every == 0 || n == steps) sim.check_finite();
-    } catch (const UserError& e) {
-      diverged = e.what();
-    }
-    q.poll();
-    int stop = stop_signal_received() != 0;
-    MPI_Allreduce(MPI_IN_PLACE, &stop, 1, MPI_INT, MPI_LOR, comm);
-    if (stop) {
-      interrupted = true;
-      return {};
-    }
-    if (diverged.empty() && (n % every == 0 || n == steps)) sampler.take(sim);
+  if (!run_passes(sim, sampler, every, q, comm, diverged)) {
+    interrupted = true;
+    return {};
   }
   nlohmann::json c = classify_species(sim, sm, &sampler.samples(sm), diverged);
   const nlohmann::json st = stability_record(sim);

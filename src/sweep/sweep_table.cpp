@@ -125,45 +125,73 @@ void map_point(MapSetup& ms, size_t p, double* out) {
   }
 }
 
-} // namespace
-
-nlohmann::json stability_map(const SweepSpec& spec, const std::string& base_dir, MPI_Comm comm) {
-  std::unique_ptr<MapSetup> ms;
-  std::string err;
-  try {
-    ms = map_setup(spec, base_dir);
-  } catch (const std::exception& e) {
-    err = e.what();
-  }
-  try {
-    throw_if_any(comm, err);
-  } catch (const UserError& e) {
-    return {{"error", e.what()}};
-  }
-  if (!ms) return {}; // the same on every rank: the setup depends on the spec and deck only
-  int rank = 0, size = 1;
-  MPI_Comm_rank(comm, &rank);
-  MPI_Comm_size(comm, &size);
-  // Point p on rank p mod size, zeros elsewhere: the sum on rank 0 is each point's own values.
-  std::vector<double> v(4 * ms->total, 0.0);
-  for (size_t p = static_cast<size_t>(rank); p < ms->total; p += static_cast<size_t>(size))
-    map_point(*ms, p, &v[4 * p]);
-  MPI_Reduce(rank == 0 ? MPI_IN_PLACE : v.data(), v.data(), static_cast<int>(v.size()), MPI_DOUBLE,
-             MPI_SUM, 0, comm);
-  if (rank != 0) return {};
+// The map's JSON from the four values per point of map_point.
+nlohmann::json map_json(const std::vector<std::vector<double>>& axes,
+                        const std::vector<double>& v) {
   nlohmann::json turing = nlohmann::json::array(), hopf = nlohmann::json::array(),
                  hopf_region = nlohmann::json::array(), wl = nlohmann::json::array();
-  for (size_t p = 0; p < ms->total; ++p) {
+  for (size_t p = 0; 4 * p < v.size(); ++p) {
     turing.push_back(v[4 * p] != 0);
     hopf.push_back(v[4 * p + 1] != 0);
     hopf_region.push_back(v[4 * p + 2] != 0);
     wl.push_back(std::isnan(v[4 * p + 3]) ? nlohmann::json() : nlohmann::json(v[4 * p + 3]));
   }
-  return {{"axes", ms->axes},
+  return {{"axes", axes},
           {"turing", turing},
           {"hopf", hopf},
           {"hopf_region", hopf_region},
           {"wavelength", wl}};
+}
+
+} // namespace
+
+nlohmann::json stability_map(const SweepSpec& spec, const std::string& base_dir, MPI_Comm comm) {
+  // Rank 0 sets up first; the other ranks share the points only for a base grid of at most
+  // kShareCells cells, as each holds a one-rank copy of the run (points of larger grids take far
+  // longer than the map, which rank 0 then computes alone).
+  constexpr long long kShareCells = 1 << 20;
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  std::unique_ptr<MapSetup> ms;
+  std::string err;
+  unsigned long long info[3] = {0, 0, 0}; // a map, shared, points
+  auto setup = [&] {
+    try {
+      ms = map_setup(spec, base_dir);
+    } catch (const std::exception& e) {
+      err = e.what();
+    }
+  };
+  if (rank == 0) {
+    setup();
+    if (ms) {
+      info[0] = 1;
+      info[1] = ms->sim->grid().global_cells() <= kShareCells;
+      info[2] = ms->total;
+    }
+  }
+  MPI_Bcast(info, 3, MPI_UNSIGNED_LONG_LONG, 0, comm);
+  if (rank != 0 && info[1]) {
+    setup();
+    if (err.empty() && (!ms || ms->total != info[2])) err = "stability map: set-up differs by rank";
+  }
+  try {
+    throw_if_any(comm, err);
+  } catch (const UserError& e) {
+    return rank == 0 ? nlohmann::json{{"error", e.what()}} : nlohmann::json();
+  }
+  if (!info[0]) return {};
+  const int parts = info[1] ? size : 1;
+  // Point p on rank p mod parts, zeros elsewhere: the sum on rank 0 is each point's own values.
+  const size_t total = info[2];
+  std::vector<double> v(4 * total, 0.0);
+  if (rank < parts)
+    for (size_t p = static_cast<size_t>(rank); p < total; p += static_cast<size_t>(parts))
+      map_point(*ms, p, &v[4 * p]);
+  MPI_Reduce(rank == 0 ? MPI_IN_PLACE : v.data(), v.data(), static_cast<int>(v.size()), MPI_DOUBLE,
+             MPI_SUM, 0, comm);
+  return rank == 0 ? map_json(ms->axes, v) : nlohmann::json();
 }
 
 std::string write_sweep_table(const std::string& dir, const SweepSpec& spec,

@@ -76,7 +76,6 @@ def test_ready_file_reads_as_double_image_with_formula_rule(tmp_path, dim, n):
     assert params == {"timestep": 1, "D_a": 0.082, "D_b": 0.041, "K": 0.064, "F": 0.035}
     formula = rule.find("formula")
     assert formula.get("number_of_chemicals") == "2" and formula.get("accuracy") == "medium"
-    assert "1.0f" not in formula.text  # a float literal would demote the double kernel
     assert rd.find("initial_pattern_generator").get("apply_when_loading") == "true"
 
 
@@ -105,9 +104,15 @@ def test_errors_are_one_line(tmp_path):
     r = run_script("--rdy", str(tmp_path / "missing"))
     assert r.returncode == 2 and r.stderr.strip().count("\n") == 0
     assert "--rdy" in r.stderr and "not an executable" in r.stderr
-    r = run_script("--rdy", fake_rdy(tmp_path), "--cases", "4d:10")
-    assert r.returncode == 2 and "--cases 4d:10" in r.stderr
+    r = run_script("--rdy", fake_rdy(tmp_path), "--cases", "4d:12")
+    assert r.returncode == 2 and "--cases 4d:12" in r.stderr
+    r = run_script("--rdy", fake_rdy(tmp_path), "--cases", "2d:30")  # Ready's 4-cell blocks
+    assert r.returncode == 2 and "--cases 2d:30" in r.stderr and "multiple of 4" in r.stderr
     failing = fake_rdy(tmp_path, FAKE_RDY.replace('"FAIL" in a', "True"))
     r = run_script("--rdy", failing, "--cases", "2d:16", "--updates", "2560", "--repeat", "1")
     assert r.returncode == 2 and r.stderr.strip().count("\n") == 0
     assert "rdy (" in r.stderr and "code 3" in r.stderr and "OpenCL build failed" in r.stderr
+    # morphogen's own error line, not mpiexec's banner after it
+    r = run_script("--rdy", fake_rdy(tmp_path), "--cases", "2d:16", "--updates", "2560",
+                   "--repeat", "1", "--morphogen", str(tmp_path / "no_such_morphogen"))
+    assert r.returncode == 2 and "morphogen (" in r.stderr, r.stderr

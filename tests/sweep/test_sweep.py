@@ -112,6 +112,17 @@ def test_group_layout_does_not_change_results(tmp_path):
     assert maps[0] == maps[2] and maps[1] == maps[2]
 
 
+def test_stability_map_of_a_large_grid_on_rank_0(tmp_path):
+    # Over 2^20 cells the other ranks do not set up a copy of the run: rank 0 computes the map.
+    base = ["sweep", DECK, "-grid_n", "1040,1040", "-grid_L", "10.15625", "-steps", "1",
+            "-sweep_params_F", "0.03,0.05", "-sweep_params_k", "0.06,0.065"]
+    ok(run(base + ["-output_dir", "one"], tmp_path, 1))
+    ok(run(base + ["-output_dir", "two"], tmp_path, 2))
+    maps = [table(tmp_path / d)["stability_map"] for d in ("one", "two")]
+    assert len(maps[0]["hopf"]) == 25 and 0 < sum(maps[0]["hopf"]) < 25
+    assert maps[0] == maps[1]
+
+
 @pytest.mark.parametrize("args,needle", [
     (["-sweep_axes", "params_F", "-sweep_params_F", "linspace(1,2)"], "-sweep_params_F"),
     (["-sweep_params_F", "0.01,zz"], "-sweep_params_F"),
