@@ -211,7 +211,12 @@ void box_line(double* a, int n, std::ptrdiff_t stride, int r, bool periodic,
     prefix[i + 1] = prefix[i] + a[i * stride];
   const double total = prefix[n];
   auto S = [&](long x) { // sum of the periodic extension over [0, x)
-    const long q = (x >= 0) ? x / n : -((-x + n - 1) / n);
+    // q = floor(x / n); no division for x in [-n, 2n) (r < n: every call of the loop below)
+    const long q = x >= 0    ? (x < n        ? 0
+                                : x < 2L * n ? 1
+                                             : x / n)
+                   : x >= -n ? -1
+                             : -((-x + n - 1) / n);
     return static_cast<double>(q) * total + prefix[static_cast<std::size_t>(x - q * n)];
   };
   for (int i = 0; i < n; ++i) {
@@ -253,7 +258,7 @@ void compute_coherence(const double* u, const FieldShape2D& s, PatternMetrics& m
   auto at = [&](int i, int j) { return u[i + static_cast<std::size_t>(nx) * j]; };
   auto deriv = [](int i, int len, bool periodic, double h, auto&& get) {
     if (len < 2) return 0.0;
-    if (periodic) return (get((i + 1) % len) - get((i - 1 + len) % len)) / (2 * h);
+    if (periodic) return (get(i + 1 == len ? 0 : i + 1) - get(i == 0 ? len - 1 : i - 1)) / (2 * h);
     if (i == 0) return (get(1) - get(0)) / h;
     if (i == len - 1) return (get(len - 1) - get(len - 2)) / h;
     return (get(i + 1) - get(i - 1)) / (2 * h);
@@ -326,7 +331,7 @@ public:
     const long bx = offx_[b] * (b != rb), by = offy_[b] * (b != rb);
     if (ra == rb) {
       const long wx = ax + dx - bx, wy = ay + dy - by;
-      add_winding(ra, wx / nx, wy / ny);
+      if (wx != 0 || wy != 0) add_winding(ra, wx / nx, wy / ny); // (a closed loop: usually 0)
       return;
     }
     // u(rb) - u(ra) = (u(b) - bx) - (u(a) - ax) = dx - bx + ax.

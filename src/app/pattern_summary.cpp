@@ -150,17 +150,28 @@ void FieldSampler::take(Simulation& sim) {
   }
 }
 
-nlohmann::json classify_species(Simulation& sim, int species, const analysis::RunSamples* samples,
-                                const std::string& diverged) {
+std::vector<double> gather_species_slice(Simulation& sim, int species, int root) {
   const Grid& g = sim.grid();
   const PetscInt kz = g.dim() == 3 ? g.spec().n[2] / 2 : 0;
   const PetscScalar* a;
   MG_PETSC(VecGetArrayRead(sim.state()[species], &a));
-  std::vector<double> field = io::gather_xy_slice(g, a, kz);
+  std::vector<double> field = io::gather_xy_slice(g, a, kz, root);
   MG_PETSC(VecRestoreArrayRead(sim.state()[species], &a));
+  return field;
+}
+
+nlohmann::json classify_species(Simulation& sim, int species, const analysis::RunSamples* samples,
+                                const std::string& diverged) {
+  const std::vector<double> field = gather_species_slice(sim, species, 0);
   int rank = 0;
-  MPI_Comm_rank(g.comm(), &rank);
+  MPI_Comm_rank(sim.grid().comm(), &rank);
   if (rank != 0) return {};
+  return classify_slice(sim, field, samples, diverged);
+}
+
+nlohmann::json classify_slice(const Simulation& sim, const std::vector<double>& field,
+                              const analysis::RunSamples* samples, const std::string& diverged) {
+  const Grid& g = sim.grid();
   analysis::FieldShape2D shape;
   shape.nx = static_cast<int>(g.spec().n[0]);
   shape.ny = static_cast<int>(g.spec().n[1]);

@@ -3,7 +3,7 @@
 //    standard deviation, RMS change per cell since the previous sample, the value at the cell
 //    (nx/3, ny/3, nz/3)), one allreduce per sample;
 //  - classify_species: the final field of one species (2-D, or the middle z slice in 3-D)
-//    gathered to rank 0, its pattern metrics (analysis/pattern_metrics.hpp), the run's dynamics
+//    gathered to one rank, its pattern metrics (analysis/pattern_metrics.hpp), the run's dynamics
 //    from the samples (analysis/time_series.hpp) and the class (analysis/classify.hpp);
 //  - stability_record: linear (Turing/Hopf) stability of the run's parameters (spatial means
 //    where they vary) on its grid (analysis/linear_stability.hpp), with the fastest-growing
@@ -38,9 +38,17 @@ private:
 
 // Collective. On rank 0: {"class", "reason", "metrics", "dynamics"}; elsewhere null.
 // samples may be null (class from the final field only). diverged: the run's NaN message
-// (class blowup).
+// (class blowup). It is gather_species_slice to rank 0, then classify_slice there.
 nlohmann::json classify_species(Simulation& sim, int species, const analysis::RunSamples* samples,
                                 const std::string& diverged = "");
+
+// Collective: the field classify_species classifies (2-D, or the middle z slice in 3-D), nx*ny
+// values on rank `root`, empty elsewhere.
+std::vector<double> gather_species_slice(Simulation& sim, int species, int root);
+
+// Not collective: classify_species's result for a gathered field.
+nlohmann::json classify_slice(const Simulation& sim, const std::vector<double>& field,
+                              const analysis::RunSamples* samples, const std::string& diverged);
 
 // Collective. Parameters that vary in space are analysed at their spatial means (listed in
 // "parameters_averaged").

@@ -11,6 +11,7 @@
 #include <csignal>
 #include <sys/statvfs.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -291,6 +292,63 @@ void RunOutput::print_output_times(double summary_seconds) const {
   std::fflush(stdout);
 }
 
+// The class of every species, on rank 0 (null elsewhere). In rounds of up to `size` species,
+// each species' field is gathered to rank s mod size (one field per rank at a time), then every
+// rank classifies its own, side by side; the results go to rank 0 as JSON text (doubles
+// round-trip exactly). Collective.
+nlohmann::json RunOutput::classify_all(Simulation& sim) const {
+  MPI_Comm comm = sim.grid().comm();
+  const int ns = static_cast<int>(sim.species().size());
+  std::vector<nlohmann::json> c(static_cast<size_t>(ns));
+  std::string err;
+  for (int first = 0; first < ns; first += size_) {
+    std::vector<double> field;
+    int mine = -1;
+    for (int s = first; s < std::min(ns, first + size_); ++s) {
+      std::vector<double> f = gather_species_slice(sim, s, s % size_);
+      if (s % size_ == rank_) {
+        field = std::move(f);
+        mine = s;
+      }
+    }
+    if (mine < 0) continue;
+    const analysis::RunSamples* samples = sampler_.count() >= 4 ? &sampler_.samples(mine) : nullptr;
+    try {
+      c[static_cast<size_t>(mine)] = classify_slice(sim, field, samples, "");
+    } catch (const std::exception& e) {
+      err = e.what();
+    }
+  }
+  throw_if_any(comm, err);
+  collect_on_rank0(comm, c);
+  if (rank_ != 0) return nullptr;
+  nlohmann::json species = nlohmann::json::object();
+  for (int s = 0; s < ns; ++s)
+    species[sim.species()[static_cast<size_t>(s)]] = std::move(c[static_cast<size_t>(s)]);
+  return species;
+}
+
+// c[s] computed on rank s mod size, moved to rank 0 as JSON text (tag s). Collective.
+void RunOutput::collect_on_rank0(MPI_Comm comm, std::vector<nlohmann::json>& c) const {
+  for (int s = 0; s < static_cast<int>(c.size()); ++s) {
+    const int root = s % size_;
+    if (root == 0 || (rank_ != 0 && rank_ != root)) continue;
+    if (rank_ == root) {
+      const std::string text =
+          c[static_cast<size_t>(s)].dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+      MPI_Send(text.data(), static_cast<int>(text.size()), MPI_CHAR, 0, s, comm);
+      continue;
+    }
+    MPI_Status st;
+    MPI_Probe(root, s, comm, &st);
+    int len = 0;
+    MPI_Get_count(&st, MPI_CHAR, &len);
+    std::string text(static_cast<size_t>(len), '\0');
+    MPI_Recv(text.data(), len, MPI_CHAR, root, s, comm, MPI_STATUS_IGNORE);
+    c[static_cast<size_t>(s)] = nlohmann::json::parse(text);
+  }
+}
+
 void RunOutput::finish(Simulation& sim) {
   write_snapshot(sim);
   if (sim.output().checkpoint_final) write_checkpoint(sim);
@@ -299,13 +357,7 @@ void RunOutput::finish(Simulation& sim) {
     return;
   }
   const double t0 = MPI_Wtime();
-  nlohmann::json species = nlohmann::json::object();
-  for (size_t s = 0; s < sim.species().size(); ++s) {
-    nlohmann::json c =
-        classify_species(sim, static_cast<int>(s),
-                         sampler_.count() >= 4 ? &sampler_.samples(static_cast<int>(s)) : nullptr);
-    if (rank_ == 0) species[sim.species()[s]] = std::move(c);
-  }
+  nlohmann::json species = classify_all(sim);
   nlohmann::json stability = stability_record(sim);
   if (rank_ != 0) {
     print_output_times(0);

@@ -18,6 +18,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace morphogen {
 
@@ -84,6 +85,8 @@ private:
   void write_snapshot(Simulation& sim);
   void write_checkpoint(Simulation& sim);
   void print_output_times(double summary_seconds) const;
+  nlohmann::json classify_all(Simulation& sim) const;
+  void collect_on_rank0(MPI_Comm comm, std::vector<nlohmann::json>& c) const;
   [[noreturn]] void write_failed(const std::string& what, const std::string& path,
                                  const std::string& err) const;
   int poll_stop_flags(const Simulation& sim);
