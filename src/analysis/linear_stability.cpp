@@ -736,38 +736,45 @@ std::vector<std::vector<double>> find_steady_states(const ModelInfo& entry,
   for (int s = 0; s < n; ++s)
     starts *= pts;
 
-  auto start = [&](long long c) {
-    std::vector<double> u(n);
+  // Start c (a grid point) into u[0..n-1]; stack arrays throughout: a search is thousands of
+  // starts (4,225 for two species), once per sweep point and per stability-map point.
+  auto start = [&](long long c, double* u) {
     for (int s = 0; s < n; ++s, c /= pts)
       u[s] = pts == 1 ? 0.5 * (lo[s] + hi[s]) : lo[s] + (hi[s] - lo[s]) * (c % pts) / (pts - 1);
-    return u;
+  };
+  auto max_abs_n = [n](const double* x) {
+    double m = 0;
+    for (int s = 0; s < n; ++s)
+      m = std::max(m, std::abs(x[s]));
+    return m;
   };
   // Residual scale: the largest |R| over the starts (a root must be 1e-10 of it).
   double rscale = 1;
   for (long long c = 0; c < starts; ++c) {
-    double R[kMaxSpecies];
-    entry.rates(start(c).data(), params.data(), R);
+    double u[kMaxSpecies], R[kMaxSpecies];
+    start(c, u);
+    entry.rates(u, params.data(), R);
     for (int s = 0; s < n; ++s)
       if (std::isfinite(R[s])) rscale = std::max(rscale, std::abs(R[s]));
   }
 
   std::vector<std::vector<double>> found;
-  auto newton = [&](std::vector<double> u) {
+  const double bound = 1e3 * (1 + std::max(max_abs(lo), max_abs(hi)));
+  auto newton = [&](double* u) { // u: the start, overwritten by the iterates
     double R[kMaxSpecies], J[kMaxSpecies * kMaxSpecies];
-    const double bound = 1e3 * (1 + std::max(max_abs(lo), max_abs(hi)));
     for (int it = 0; it < search.max_it; ++it) {
-      entry.rates(u.data(), params.data(), R);
-      entry.jacobian(u.data(), params.data(), J);
+      entry.rates(u, params.data(), R);
+      entry.jacobian(u, params.data(), J);
       if (!solve_small(n, J, R)) return;
       double step = 0;
       for (int s = 0; s < n; ++s) {
         u[s] -= R[s];
         step = std::max(step, std::abs(R[s]));
       }
-      if (!std::isfinite(step) || max_abs(u) > bound) return;
-      if (step <= 1e-15 * (1 + max_abs(u))) break;
+      if (!std::isfinite(step) || max_abs_n(u) > bound) return;
+      if (step <= 1e-15 * (1 + max_abs_n(u))) break;
     }
-    entry.rates(u.data(), params.data(), R);
+    entry.rates(u, params.data(), R);
     double res = 0;
     for (int s = 0; s < n; ++s)
       res = std::max(res, std::abs(R[s]));
@@ -777,13 +784,19 @@ std::vector<std::vector<double>> find_steady_states(const ModelInfo& entry,
       double d = 0;
       for (int s = 0; s < n; ++s)
         d = std::max(d, std::abs(u[s] - v[s]));
-      if (d <= 1e-5 * (1 + max_abs(u))) return;
+      if (d <= 1e-5 * (1 + max_abs_n(u))) return;
     }
-    found.push_back(u);
+    found.emplace_back(u, u + n);
   };
-  if (has_own) newton(own);
-  for (long long c = 0; c < starts; ++c)
-    newton(start(c));
+  double u[kMaxSpecies];
+  if (has_own) {
+    std::copy(own.begin(), own.end(), u);
+    newton(u);
+  }
+  for (long long c = 0; c < starts; ++c) {
+    start(c, u);
+    newton(u);
+  }
   std::sort(found.begin(), found.end());
   return found;
 }
