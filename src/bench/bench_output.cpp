@@ -69,9 +69,6 @@ void bench_output(MPI_Comm comm, Options& opt, int n) {
     Simulation sim(comm, opt, "");
     const double setup = MPI_Wtime() - t0;
     const double cells = static_cast<double>(sim.grid().global_cells());
-    const double ns_perturbed = 1e9 * fill_seconds(sim.grid(), "12 +- 0.1% gauss") * size / cells;
-    const double ns_expr =
-        1e9 * fill_seconds(sim.grid(), "12 + 0.5*sin(x/17)*cos(y/13)") * size / cells;
     sim.step();
     sim.step();
     PngOutput pngs(opt, sim);
@@ -84,14 +81,20 @@ void bench_output(MPI_Comm comm, Options& opt, int n) {
     getrusage(RUSAGE_SELF, &ru);
     double rss = static_cast<double>(ru.ru_maxrss) * 1024.0, rss_sum = 0;
     MPI_Reduce(&rss, &rss_sum, 1, MPI_DOUBLE, MPI_SUM, 0, comm);
+    // The fill timings after the peak is read: their scratch field is the bench's, not the run's.
+    const double ns_perturbed = 1e9 * fill_seconds(sim.grid(), "12 +- 0.1% gauss") * size / cells;
+    const double ns_expr =
+        1e9 * fill_seconds(sim.grid(), "12 + 0.5*sin(x/17)*cos(y/13)") * size / cells;
+    auto met = [](bool ok) { return ok ? "met" : "NOT met"; };
     PetscPrintf(comm,
                 "output_%dx%d setup_s=%.3f fill_ns_per_cell_perturbed=%.1f "
-                "fill_ns_per_cell_expression=%.1f (target <= 50, rank-seconds per cell) "
-                "png_s=%.3f (target <= 1, %d species, -png_max_size %lld) "
-                "peak_rss_bytes_per_cell=%.1f (target <= 64: setup, 2 steps, images)\n",
-                n, n, setup, ns_perturbed, ns_expr, png,
-                static_cast<int>(sim.output().png_species.size()), pngs.max_size(),
-                rss_sum / cells);
+                "fill_ns_per_cell_expression=%.1f (target <= 50, rank-seconds per cell: %s) "
+                "png_s=%.3f (target <= 1, %d species, -png_max_size %lld: %s) "
+                "peak_rss_bytes_per_cell=%.1f (target <= 64: setup, 2 steps, images, all ranks: "
+                "%s)\n",
+                n, n, setup, ns_perturbed, ns_expr, met(ns_perturbed <= 50 && ns_expr <= 50), png,
+                static_cast<int>(sim.output().png_species.size()), pngs.max_size(), met(png <= 1.0),
+                rss_sum / cells, met(rss_sum / cells <= 64));
   }
   for (const char* k : kKeys)
     MG_PETSC(PetscOptionsClearValue(nullptr, k));

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 
 namespace morphogen::sweep {
 
@@ -65,6 +67,17 @@ std::string csv_row(const nlohmann::json& r, const std::vector<std::string>& axe
   for (const auto& c : cols)
     row += "," + cell(c);
   return row + "\n";
+}
+
+nlohmann::json read_record(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) return nlohmann::json(nlohmann::json::value_t::discarded);
+  const std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  using Event = nlohmann::json::parse_event_t;
+  auto no_series = [](int depth, Event e, nlohmann::json& parsed) {
+    return !(depth == 1 && e == Event::key && parsed == "series");
+  };
+  return nlohmann::json::parse(text, no_series, false);
 }
 
 } // namespace morphogen::sweep

@@ -16,4 +16,9 @@ std::string csv_header(const std::vector<std::string>& axes, bool listed);
 std::string csv_row(const nlohmann::json& record, const std::vector<std::string>& axes,
                     bool listed);
 
+// The record of a point file without its time series ("series": most of the file), as the table
+// and the resume check read it: the file read whole, then parsed (nlohmann's stream input reads a
+// character at a time). Discarded (is_discarded()) when the file is missing or not JSON.
+nlohmann::json read_record(const std::string& path);
+
 } // namespace morphogen::sweep

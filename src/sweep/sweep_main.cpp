@@ -18,7 +18,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
@@ -234,8 +233,7 @@ std::vector<long long> finished_points(const std::string& dir, const SweepSpec& 
     if (std::sscanf(f.c_str(), "point_%lld.%7s", &p, tail) != 2 || std::string(tail) != "json" ||
         p < 0 || p >= n || f != point_file(p, "json"))
       continue;
-    std::ifstream in(it->path());
-    const nlohmann::json r = nlohmann::json::parse(in, nullptr, false);
+    const nlohmann::json r = read_record(it->path().string());
     if (r.is_discarded() || !r.contains("class") || !r.contains("params") || r["class"] == "error")
       continue;
     const auto idx = spec.indices(p);

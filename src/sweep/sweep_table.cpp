@@ -13,7 +13,6 @@
 
 #include <cmath>
 #include <fcntl.h>
-#include <fstream>
 #include <map>
 #include <memory>
 #include <sys/file.h>
@@ -210,11 +209,8 @@ std::string write_sweep_table(const std::string& dir, const SweepSpec& spec,
   nlohmann::json records = nlohmann::json::array();
   std::map<std::string, int> classes;
   for (long long p = 0; p < spec.points(); ++p) {
-    std::ifstream f(dir + "/points/" + point_file(p, "json"));
-    if (!f) continue;
-    nlohmann::json r = nlohmann::json::parse(f, nullptr, false);
+    nlohmann::json r = read_record(dir + "/points/" + point_file(p, "json"));
     if (r.is_discarded() || !r.contains("class")) continue;
-    r.erase("series");
     csv += csv_row(r, names, spec.listed);
     ++classes[r["class"].get<std::string>()];
     records.push_back(std::move(r));
