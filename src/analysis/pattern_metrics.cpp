@@ -291,10 +291,18 @@ void compute_coherence(const double* u, const FieldShape2D& s, PatternMetrics& m
 
 class DisplacedUnionFind {
 public:
-  explicit DisplacedUnionFind(std::size_t n)
-      : parent_(n), size_(n, 1), offx_(n, 0), offy_(n, 0), rank_(n, 0), w1x_(n, 0), w1y_(n, 0) {
+  // n singletons; reset reuses the arrays' memory (no new pages for a second labelling).
+  explicit DisplacedUnionFind(std::size_t n = 0) { reset(n); }
+  void reset(std::size_t n) {
+    parent_.resize(n);
     for (std::size_t c = 0; c < n; ++c)
       parent_[c] = static_cast<std::int32_t>(c);
+    size_.assign(n, 1);
+    offx_.assign(n, 0);
+    offy_.assign(n, 0);
+    rank_.assign(n, 0);
+    w1x_.assign(n, 0);
+    w1y_.assign(n, 0);
   }
 
   // Root of x; afterwards offset(x) = u(x) - u(root) in unwrapped cells.
@@ -423,14 +431,38 @@ void validate(const FieldShape2D& s) {
 
 } // namespace
 
+namespace {
+
+// The labelling's per-cell arrays, kept between the two phases' labellings.
+struct LabelWorkspace {
+  DisplacedUnionFind uf;
+  std::vector<std::int32_t> comp_of;
+};
+
+std::vector<Component> label_components_in(const unsigned char* mask, const FieldShape2D& s,
+                                           int connectivity, double max_spot_area,
+                                           LabelWorkspace& ws);
+
+} // namespace
+
 std::vector<Component> label_components(const unsigned char* mask, const FieldShape2D& s,
                                         int connectivity, double max_spot_area) {
+  LabelWorkspace ws;
+  return label_components_in(mask, s, connectivity, max_spot_area, ws);
+}
+
+namespace {
+
+std::vector<Component> label_components_in(const unsigned char* mask, const FieldShape2D& s,
+                                           int connectivity, double max_spot_area,
+                                           LabelWorkspace& ws) {
   validate(s);
   if (connectivity != 4 && connectivity != 8)
     throw std::invalid_argument("pattern metrics: connectivity must be 4 or 8");
   const int nx = s.nx, ny = s.ny;
   const std::size_t n = static_cast<std::size_t>(nx) * ny;
-  DisplacedUnionFind uf(n);
+  DisplacedUnionFind& uf = ws.uf;
+  uf.reset(n);
   auto idx = [nx](int i, int j) { return static_cast<std::int32_t>(i + nx * j); };
   // Link (i, j) with its neighbour at (i + dx, j + dy) if both are members.
   auto link = [&](int i, int j, int dx, int dy) {
@@ -456,7 +488,8 @@ std::vector<Component> label_components(const unsigned char* mask, const FieldSh
       }
     }
 
-  std::vector<std::int32_t> comp_of(n, -1);
+  std::vector<std::int32_t>& comp_of = ws.comp_of;
+  comp_of.assign(n, -1);
   std::vector<Moments> mom;
   for (int j = 0; j < ny; ++j)
     for (int i = 0; i < nx; ++i) {
@@ -512,6 +545,8 @@ std::vector<Component> label_components(const unsigned char* mask, const FieldSh
   }
   return out;
 }
+
+} // namespace
 
 long euler_characteristic_4(const unsigned char* mask, const FieldShape2D& s) {
   validate(s);
@@ -569,8 +604,10 @@ PatternMetrics compute_pattern_metrics(const double* u, const FieldShape2D& s) {
   const double max_spot_area = m.wavelength > 0
                                    ? kSpotMaxAreaWavelengths * m.wavelength * m.wavelength
                                    : std::numeric_limits<double>::infinity();
-  summarise_phase(label_components(hi.data(), s, 4, max_spot_area), nhi, total, m.high);
-  summarise_phase(label_components(lo.data(), s, 8, max_spot_area), total - nhi, total, m.low);
+  LabelWorkspace ws;
+  summarise_phase(label_components_in(hi.data(), s, 4, max_spot_area, ws), nhi, total, m.high);
+  summarise_phase(label_components_in(lo.data(), s, 8, max_spot_area, ws), total - nhi, total,
+                  m.low);
   m.high.spot_area = m.high.spot_area_cells * s.hx * s.hy;
   m.low.spot_area = m.low.spot_area_cells * s.hx * s.hy;
   m.euler = euler_characteristic_4(hi.data(), s);
