@@ -3,7 +3,7 @@ rank s mod size (src/app/run_output.cpp, RunOutput::classify_all) and the result
 rank 0. The fields are bitwise those of one rank (explicit run), so every species' class and
 metrics must be exactly the one-rank ones, in the right species' entry, whether a rank has
 several species (5 species on 2 ranks: rounds {a, b}, {c, d}, {e}) or none (2 species on 3
-ranks)."""
+ranks), and in 3-D, where a species' root need not own the middle z slice (4 ranks)."""
 import json
 import os
 
@@ -16,6 +16,9 @@ CASES = {
     "oregonator_5": [os.path.join(SOURCE, "input", "oregonator_three_layer.yaml"), "-steps", "300"],
     # two species, spots forming on a small grid
     "turing_2": ["-grid_n", "64,64", "-steps", "400"],
+    # 3-D: the middle z slice, which not every rank (nor every species' root) owns
+    "turing_3d": [os.path.join(SOURCE, "input", "turing_spots_3d.yaml"), "-grid_n", "24,24,24",
+                  "-steps", "100"],
 }
 
 
@@ -28,7 +31,7 @@ def summary(workdir, case, ranks):
 
 
 @pytest.mark.parametrize("case,ranks", [("oregonator_5", 2), ("oregonator_5", 3),
-                                        ("turing_2", 2), ("turing_2", 3)])
+                                        ("turing_2", 2), ("turing_2", 3), ("turing_3d", 4)])
 def test_every_species_classified_as_on_one_rank(workdir, case, ranks):
     one = summary(workdir, case, 1)
     many = summary(workdir, case, ranks)
