@@ -232,10 +232,10 @@ bool solve_small(int n, double* M, double* b) {
   return true;
 }
 
-double max_abs(const std::vector<double>& v) {
+double max_abs(const double* x, int n) {
   double m = 0;
-  for (double x : v)
-    m = std::max(m, std::abs(x));
+  for (int s = 0; s < n; ++s)
+    m = std::max(m, std::abs(x[s]));
   return m;
 }
 
@@ -742,12 +742,6 @@ std::vector<std::vector<double>> find_steady_states(const ModelInfo& entry,
     for (int s = 0; s < n; ++s, c /= pts)
       u[s] = pts == 1 ? 0.5 * (lo[s] + hi[s]) : lo[s] + (hi[s] - lo[s]) * (c % pts) / (pts - 1);
   };
-  auto max_abs_n = [n](const double* x) {
-    double m = 0;
-    for (int s = 0; s < n; ++s)
-      m = std::max(m, std::abs(x[s]));
-    return m;
-  };
   // Residual scale: the largest |R| over the starts (a root must be 1e-10 of it).
   double rscale = 1;
   for (long long c = 0; c < starts; ++c) {
@@ -759,7 +753,7 @@ std::vector<std::vector<double>> find_steady_states(const ModelInfo& entry,
   }
 
   std::vector<std::vector<double>> found;
-  const double bound = 1e3 * (1 + std::max(max_abs(lo), max_abs(hi)));
+  const double bound = 1e3 * (1 + std::max(max_abs(lo.data(), n), max_abs(hi.data(), n)));
   auto newton = [&](double* u) { // u: the start, overwritten by the iterates
     double R[kMaxSpecies], J[kMaxSpecies * kMaxSpecies];
     for (int it = 0; it < search.max_it; ++it) {
@@ -771,8 +765,8 @@ std::vector<std::vector<double>> find_steady_states(const ModelInfo& entry,
         u[s] -= R[s];
         step = std::max(step, std::abs(R[s]));
       }
-      if (!std::isfinite(step) || max_abs_n(u) > bound) return;
-      if (step <= 1e-15 * (1 + max_abs_n(u))) break;
+      if (!std::isfinite(step) || max_abs(u, n) > bound) return;
+      if (step <= 1e-15 * (1 + max_abs(u, n))) break;
     }
     entry.rates(u, params.data(), R);
     double res = 0;
@@ -784,7 +778,7 @@ std::vector<std::vector<double>> find_steady_states(const ModelInfo& entry,
       double d = 0;
       for (int s = 0; s < n; ++s)
         d = std::max(d, std::abs(u[s] - v[s]));
-      if (d <= 1e-5 * (1 + max_abs_n(u))) return;
+      if (d <= 1e-5 * (1 + max_abs(u, n))) return;
     }
     found.emplace_back(u, u + n);
   };

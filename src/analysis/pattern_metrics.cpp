@@ -429,29 +429,11 @@ void validate(const FieldShape2D& s) {
     throw std::invalid_argument("pattern metrics: spacing must be positive and finite");
 }
 
-} // namespace
-
-namespace {
-
 // The labelling's per-cell arrays, kept between the two phases' labellings.
 struct LabelWorkspace {
   DisplacedUnionFind uf;
   std::vector<std::int32_t> comp_of;
 };
-
-std::vector<Component> label_components_in(const unsigned char* mask, const FieldShape2D& s,
-                                           int connectivity, double max_spot_area,
-                                           LabelWorkspace& ws);
-
-} // namespace
-
-std::vector<Component> label_components(const unsigned char* mask, const FieldShape2D& s,
-                                        int connectivity, double max_spot_area) {
-  LabelWorkspace ws;
-  return label_components_in(mask, s, connectivity, max_spot_area, ws);
-}
-
-namespace {
 
 std::vector<Component> label_components_in(const unsigned char* mask, const FieldShape2D& s,
                                            int connectivity, double max_spot_area,
@@ -547,6 +529,12 @@ std::vector<Component> label_components_in(const unsigned char* mask, const Fiel
 }
 
 } // namespace
+
+std::vector<Component> label_components(const unsigned char* mask, const FieldShape2D& s,
+                                        int connectivity, double max_spot_area) {
+  LabelWorkspace ws;
+  return label_components_in(mask, s, connectivity, max_spot_area, ws);
+}
 
 long euler_characteristic_4(const unsigned char* mask, const FieldShape2D& s) {
   validate(s);
