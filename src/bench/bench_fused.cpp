@@ -1,6 +1,7 @@
 #include "bench/bench_fused.hpp"
 
 #include "app/simulation.hpp"
+#include "core/user_error.hpp"
 
 #include <algorithm>
 #include <numeric>
@@ -36,22 +37,39 @@ void set_options(const std::vector<std::pair<std::string, std::string>>& o, bool
 
 } // namespace
 
-void bench_fused(MPI_Comm comm, Options& opt, double roof) {
-  const auto ks = opt.list("bench_fuse_steps", {"4", "8"}, 0, 8,
-                           "fused explicit steps per pass timed against 1 (empty: skip)");
-  if (ks.empty()) return;
-  const auto ns =
-      opt.list("bench_fuse_n", {"2048", "4096"}, 1, 4, "grid sides of the fused-steps cases");
-  const std::string stencil =
+FusedSettings read_fused_settings(Options& opt) {
+  FusedSettings fs;
+  const auto ks =
+      opt.list("bench_fuse_steps", {"4", "8"}, 0, 8,
+               "fused explicit steps per pass timed against 1, each in [0, 64] (0: only the "
+               "one-step baseline; empty: skip the section)");
+  fs.ns = opt.list("bench_fuse_n", {"2048", "4096"}, 1, 4, "grid sides of the fused-steps cases");
+  fs.stencil =
       opt.choice("bench_fuse_stencil", "9pt", {"5pt", "9pt"}, "stencil of the fused-steps cases");
-  const PetscInt steps =
-      opt.integer("bench_fuse_steps_timed", 48, 8, 100000,
-                  "timed steps per fused-steps case (rounded to a multiple of k)");
-  std::vector<PetscInt> depth;
-  for (const auto& k : ks)
-    depth.push_back(Options::parse_int("-bench_fuse_steps", k));
+  fs.steps = opt.integer("bench_fuse_steps_timed", 48, 8, 100000,
+                         "timed steps per fused-steps case (rounded to a multiple of k)");
+  // Each k and n checked here, with the option it came from (not later as -explicit_fuse_steps
+  // or -grid_n, and no value skipped silently).
+  for (const auto& k : ks) {
+    fs.depth.push_back(Options::parse_int("bench_fuse_steps", k));
+    if (fs.depth.back() < 0 || fs.depth.back() > 64)
+      throw UserError("-bench_fuse_steps " + k + ": out of range, allowed [0, 64]");
+  }
+  for (const auto& n : fs.ns) {
+    const PetscInt side = Options::parse_int("bench_fuse_n", n);
+    if (side < 8 || side > 65536)
+      throw UserError("-bench_fuse_n " + n + ": out of range, allowed [8, 65536]");
+  }
+  return fs;
+}
+
+void bench_fused(MPI_Comm comm, Options& opt, const FusedSettings& fs, double roof) {
+  if (fs.depth.empty()) return;
+  const auto& depth = fs.depth;
+  const auto& stencil = fs.stencil;
+  const PetscInt steps = fs.steps;
   const PetscInt kmax = *std::max_element(depth.begin(), depth.end());
-  for (const auto& n : ns) {
+  for (const auto& n : fs.ns) {
     const std::vector<std::pair<std::string, std::string>> o = {
         {"-model", "gray_scott"},
         {"-grid_n", n + "," + n},

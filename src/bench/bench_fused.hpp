@@ -7,8 +7,20 @@
 
 #include "core/options.hpp"
 
+#include <string>
+#include <vector>
+
 namespace morphogen {
 
-void bench_fused(MPI_Comm comm, Options& opt, double roof);
+// The section's options, read (and checked) before any timing starts.
+struct FusedSettings {
+  std::vector<PetscInt> depth; // -bench_fuse_steps (empty: skip the section)
+  std::vector<std::string> ns; // -bench_fuse_n
+  std::string stencil;         // -bench_fuse_stencil
+  PetscInt steps = 48;         // -bench_fuse_steps_timed
+};
+FusedSettings read_fused_settings(Options& opt);
+
+void bench_fused(MPI_Comm comm, Options& opt, const FusedSettings& fs, double roof);
 
 } // namespace morphogen

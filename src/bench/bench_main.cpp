@@ -437,6 +437,21 @@ void bench_brusselator_deck(MPI_Comm comm, Options& opt, double T, double split_
   }
 }
 
+// -help: the bench's own options with their values and meaning (PETSc has printed its own
+// above); nothing is timed.
+void print_bench_help(MPI_Comm comm, const Options& opt) {
+  PetscPrintf(comm,
+              "\nmorphogen-bench %s: mpiexec -n P morphogen-bench [-option value ...]\n"
+              "Sections, in order: setup/PNG/memory at -bench_output_n, fused steps, implicit vs "
+              "explicit, explicit 2-D and 3-D, the general path, split preconditioners, strong "
+              "scaling and the weak-scaling model (README, Performance). Any morphogen option "
+              "(e.g. -explicit_in_place yes) also applies to every timed run.\n"
+              "Options (-name <value>: meaning):\n",
+              MORPHOGEN_VERSION);
+  for (const auto& r : opt.records())
+    PetscPrintf(comm, "  -%s <%s>: %s\n", r.name.c_str(), r.value.c_str(), r.help.c_str());
+}
+
 int run(MPI_Comm comm) {
   int size = 1;
   MPI_Comm_size(comm, &size);
@@ -480,6 +495,15 @@ int run(MPI_Comm comm) {
   const PetscInt fluids_steps =
       opt.integer("bench_fluids_steps", 5, 1, 100000, "timed steps per case of -bench_fluids");
   const bool only_fluids = opt.flag("bench_only_fluids", false, "only the fluids section");
+  const bool only_fused =
+      opt.flag("bench_only_fused", false, "only the fused-steps (temporal blocking) section");
+  const FusedSettings fused = read_fused_settings(opt);
+  const ScalingNetwork net = read_scaling_network(opt);
+  if (opt.help_requested()) {
+    print_bench_help(comm, opt);
+    return 0;
+  }
+  opt.check_unused("bench_"); // a mistyped -bench_* option, before minutes of timings
   if (with_fluids || only_fluids)
     bench_fluids(comm, opt, static_cast<int>(fluids_n), static_cast<int>(fluids_steps));
   if (only_fluids) return 0;
@@ -496,9 +520,7 @@ int run(MPI_Comm comm) {
     PetscPrintf(comm, "halo_%s halo_only_update_ms=%.4f dm_global_to_local_ms=%.4f\n", tag,
                 1e3 * r.halo_s, 1e3 * r.g2l_s);
   };
-  const bool only_fused =
-      opt.flag("bench_only_fused", false, "only the fused-steps (temporal blocking) section");
-  if (!only_implicit) bench_fused(comm, opt, roof);
+  if (!only_implicit) bench_fused(comm, opt, fused, roof);
   if (only_fused) return 0;
   if (with_implicit) {
     bench_reaction_kernel(comm);
@@ -606,7 +628,7 @@ int run(MPI_Comm comm) {
                      static_cast<int>(std::count(n.begin(), n.end(), ',') == 2 ? steps3 : steps2))
               .probe;
         }};
-    bench_scaling(comm, opt, probe);
+    bench_scaling(comm, opt, probe, net);
   }
   PetscPrintf(comm, "roofline_fraction=%.3f\n", r2.cups / roof);
   return 0;

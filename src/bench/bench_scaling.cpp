@@ -118,12 +118,19 @@ void weak_model(MPI_Comm comm, Options& opt, const ScalingProbes& probe, int dim
 
 } // namespace
 
-void bench_scaling(MPI_Comm comm, Options& opt, const ScalingProbes& probe) {
-  const double alpha = 1e-6 * opt.real("bench_net_latency_us", 2.0, 0.0, 1e6,
-                                       "weak-scaling model: network latency per message, us");
-  const double beta = 1e9 * opt.real("bench_net_GBps", 25.0 / 64.0, 1e-6, 1e6,
-                                     "weak-scaling model: network bandwidth per rank, GB/s "
-                                     "(default: a 200 Gb/s link shared by 64 ranks)");
+ScalingNetwork read_scaling_network(Options& opt) {
+  ScalingNetwork net;
+  net.alpha = 1e-6 * opt.real("bench_net_latency_us", 2.0, 0.0, 1e6,
+                              "weak-scaling model: network latency per message, us");
+  net.beta = 1e9 * opt.real("bench_net_GBps", 25.0 / 64.0, 1e-6, 1e6,
+                            "weak-scaling model: network bandwidth per rank, GB/s "
+                            "(default: a 200 Gb/s link shared by 64 ranks)");
+  return net;
+}
+
+void bench_scaling(MPI_Comm comm, Options& opt, const ScalingProbes& probe,
+                   const ScalingNetwork& net) {
+  const double alpha = net.alpha, beta = net.beta;
   const double bw_all = probe.stream(comm);
   for (int dim : {2, 3})
     strong(comm, opt, probe, dim, bw_all);

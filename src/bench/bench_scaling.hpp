@@ -40,7 +40,15 @@ struct ScalingProbes {
   std::function<ProbeRun(MPI_Comm, Options&, const std::string&)> explicit_run;
 };
 
+// The weak-scaling model's network (-bench_net_latency_us, -bench_net_GBps), read before any
+// timing starts: seconds per message and bytes per second per rank.
+struct ScalingNetwork {
+  double alpha = 2e-6, beta = 25e9 / 64;
+};
+ScalingNetwork read_scaling_network(Options& opt);
+
 // Prints the strong-scaling lines and the weak-scaling model. Collective on comm.
-void bench_scaling(MPI_Comm comm, Options& opt, const ScalingProbes& probe);
+void bench_scaling(MPI_Comm comm, Options& opt, const ScalingProbes& probe,
+                   const ScalingNetwork& net);
 
 } // namespace morphogen

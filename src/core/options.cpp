@@ -286,7 +286,7 @@ std::vector<std::string> Options::list(const std::string& name, const std::vecto
   return v;
 }
 
-void Options::check_unused() const {
+void Options::check_unused(const std::string& prefix) const {
   PetscInt n = 0;
   char** names = nullptr;
   char** values = nullptr;
@@ -295,6 +295,7 @@ void Options::check_unused() const {
   for (PetscInt i = 0; i < n && msg.empty(); ++i) {
     const std::string name = names[i];
     if (name == "help" || name == "h") continue;
+    if (name.compare(0, prefix.size(), prefix) != 0) continue;
     // Consumed later by a PETSc object (e.g. -diffusion_ksp_converged_reason at the first solve).
     if (std::find(known_.begin(), known_.end(), name) != known_.end()) continue;
     // PETSc's diagnostics (-*_view, -*_converged_reason, -*_monitor*) are read when a solve

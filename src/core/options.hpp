@@ -62,8 +62,10 @@ public:
     hint_ = std::move(hint);
   }
 
-  // Throw UserError for the first option set by the user that nothing read.
-  void check_unused() const;
+  // Throw UserError for the first option set by the user that nothing read; with a prefix, only
+  // options whose names start with it are considered (a program's own options, checked before
+  // the objects that read the rest exist).
+  void check_unused(const std::string& prefix = "") const;
 
   // Options that were read, as a flat YAML deck (key: "value").
   std::string to_yaml(const std::string& header) const;

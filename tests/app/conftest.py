@@ -10,8 +10,8 @@ MPIEXEC = os.environ.get("MORPHOGEN_MPIEXEC", "mpiexec")
 SOURCE = os.environ.get("MORPHOGEN_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "../.."))
 
 
-def run(args, cwd, ranks=1, timeout=300):
-    cmd = [EXE] + list(args)
+def run(args, cwd, ranks=1, timeout=300, exe=EXE):
+    cmd = [exe] + list(args)
     if ranks > 1:
         cmd = [MPIEXEC, "--oversubscribe", "-n", str(ranks)] + cmd
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",

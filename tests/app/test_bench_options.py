@@ -1,0 +1,64 @@
+"""morphogen-bench's own options: -help lists them all and times nothing; a mistyped or
+out-of-range -bench_* option is one error line and a non-zero exit before any timing starts
+(the bench otherwise runs for minutes before its first figure)."""
+import os
+import re
+
+import pytest
+from conftest import EXE, SOURCE, error_lines, run
+
+BENCH = os.path.join(os.path.dirname(EXE), "morphogen-bench")
+TIMING_LINE = re.compile(r"^(stream_triad|explicit_|output_|split_|scaling_)", re.M)
+
+
+def bench(args, cwd, ranks=1, timeout=120):
+    return run(args, cwd, ranks, timeout, exe=BENCH)
+
+
+def bench_sources_options():
+    """Every -bench_* option name the bench's sources read (opt.integer("bench_...", ...))."""
+    names = set()
+    src = os.path.join(SOURCE, "src", "bench")
+    for f in os.listdir(src):
+        if f.endswith(".cpp"):
+            text = open(os.path.join(src, f)).read()
+            names.update(re.findall(r'opt\.\w+\(\s*"(bench_\w+)"', text))
+    return names
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_help_lists_every_option_and_times_nothing(tmp_path, ranks):
+    p = bench(["-help"], tmp_path, ranks)
+    assert p.returncode == 0, p.stderr
+    listed = set(re.findall(r"^  -(bench_\w+) <", p.stdout, re.M))
+    expected = bench_sources_options()
+    assert len(expected) >= 20
+    assert listed == expected
+    assert "-bench_fuse_steps <4,8>:" in p.stdout
+    assert not TIMING_LINE.search(p.stdout), p.stdout
+    assert not os.listdir(tmp_path)
+
+
+CASES = [
+    ("misspelt", ["-bench_fuse_stepz", "3"], ["-bench_fuse_stepz", "did you mean -bench_fuse_steps"]),
+    ("fuse_negative", ["-bench_fuse_steps", "4,-2"], ["-bench_fuse_steps -2", "allowed [0, 64]"]),
+    ("fuse_too_deep", ["-bench_fuse_steps", "65"], ["-bench_fuse_steps 65", "allowed [0, 64]"]),
+    ("fuse_not_int", ["-bench_fuse_steps", "4,x"], ["-bench_fuse_steps x", "not an integer"]),
+    ("fuse_n_small", ["-bench_fuse_n", "4"], ["-bench_fuse_n 4", "allowed [8, 65536]"]),
+    ("fuse_n_not_int", ["-bench_fuse_n", "2048,big"], ["-bench_fuse_n big", "not an integer"]),
+    ("net_range", ["-bench_net_GBps", "0"], ["-bench_net_GBps", "allowed [1e-06, 1000000]"]),
+    ("side_3d", ["-bench_3d_n", "4"], ["-bench_3d_n", "allowed [8, 1024]"]),
+]
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
+def test_bad_option_fails_before_timing(tmp_path, case):
+    _, args, needles = case
+    p = bench(args, tmp_path, ranks=2, timeout=60)
+    assert p.returncode != 0
+    lines = error_lines(p)
+    assert len(lines) == 1, p.stderr
+    assert lines[0].startswith("morphogen-bench: error: ")
+    for n in needles:
+        assert n in lines[0], lines[0]
+    assert not TIMING_LINE.search(p.stdout), p.stdout
