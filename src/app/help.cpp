@@ -50,6 +50,10 @@ const Conditional kConditional[] = {
      "source term added to the species' reaction rate; may use t (default: none)"},
     {"pin_", "-pin_<species> MASK",
      "cells held at their initial value where the mask is non-zero (default: none)"},
+    {"ts_diffusion_solver", "-ts_diffusion_solver auto|ksp|spectral",
+     "with -integrator ts and implicit diffusion: each stage's linear solve by the exact "
+     "FFT/DCT inverse (spectral), by -ksp_type/-pc_type (ksp), or spectral where it applies "
+     "(auto, default)"},
     {"ts_diffusion", "-ts_diffusion implicit|explicit",
      "with -integrator ts: diffusion implicit (IMEX) or in the explicit right-hand side "
      "(default implicit)"},

@@ -368,6 +368,19 @@ void Simulation::read_time(Options& opt) {
                    "euler, ssp)") == "implicit";
   else if (opt.is_set("ts_diffusion"))
     throw UserError("-ts_diffusion: applies to -integrator ts only");
+  if (ts_ && ts_implicit_diffusion_)
+    ts_solver_ = opt.choice(
+        "ts_diffusion_solver", "auto", {"auto", "ksp", "spectral"},
+        "with -integrator ts: the implicit diffusion solve of each stage: spectral (the exact "
+        "inverse by FFT/DCT, tridiagonal along the slowest axis where it applies, as the "
+        "preconditioner of -ksp_type preonly: periodic, zero-flux or Dirichlet axes, "
+        "constant coefficients), ksp (-ksp_type/-pc_type; default CG with ICC), or auto (spectral "
+        "where "
+        "it applies and no -ksp_type, -pc_type, -sub_pc_type, -ksp_rtol, -ksp_atol or "
+        "-ksp_max_it is given)");
+  else if (opt.is_set("ts_diffusion_solver"))
+    throw UserError("-ts_diffusion_solver: applies to -integrator ts with -ts_diffusion "
+                    "implicit only");
   // With grid sequencing every level uses the finest level's dt and stability bound (the
   // bound scales with h^2), so a bad -dt fails before the first level writes anything.
   const bool constant = all_constant_diffusion();
@@ -452,8 +465,9 @@ void Simulation::read_ts(Options& opt) {
     pin_matrices();
     terms_.use_matrices(matrices_.get()); // lagged solution-dependent operators re-assembled
   }
-  ts_integrator_ = std::make_unique<TsIntegrator>(*grid_, *halo_, species_, terms_, matrices_.get(),
-                                                  dirichlet_.empty() ? nullptr : &dirichlet_, dt_);
+  ts_integrator_ =
+      std::make_unique<TsIntegrator>(*grid_, *halo_, species_, terms_, matrices_.get(),
+                                     dirichlet_.empty() ? nullptr : &dirichlet_, dt_, ts_solver_);
   stepper_ = ts_integrator_.get();
 }
 

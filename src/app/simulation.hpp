@@ -167,8 +167,9 @@ private:
   std::unique_ptr<FluidSolver> fluid_;        // before the advection stage (-fluid)
   std::unique_ptr<AdvectionStage> advection_; // after every integrator's step (-advect)
   bool split_ = false, ts_ = false, ts_implicit_diffusion_ = true;
-  bool split_fuse_ = false;   // -split_fuse_reaction: fused Strang passes (advance())
-  PetscInt level_factor_ = 1; // coarsening factor of this sequencing level (1: finest)
+  std::string ts_solver_ = "auto"; // -ts_diffusion_solver
+  bool split_fuse_ = false;        // -split_fuse_reaction: fused Strang passes (advance())
+  PetscInt level_factor_ = 1;      // coarsening factor of this sequencing level (1: finest)
   int level_index_ = 0;
   std::uint64_t seed_ = 1;
   double dt_ = 0, stable_dt_ = 0, t_ = 0;

@@ -49,20 +49,27 @@ DiffusionSolver::DiffusionSolver(const Grid& grid, const OperatorMatrices& ops,
       varying);
 }
 
-// The exact solve of species s: tridiagonal along the slowest axis (tridiagonal; auto except on
-// one rank in 3-D, where the full transform measured faster: README, Performance) or the full
-// transform (fft, and auto where the tridiagonal one does not apply); null and *why if none.
+std::unique_ptr<ExactSolve> auto_exact_solve(const Grid& grid, Mat M, std::string* why) {
+  int size = 1;
+  MPI_Comm_size(grid.comm(), &size);
+  std::string why_tri;
+  if (!(size == 1 && grid.dim() == 3))
+    if (auto t = TridiagonalSolver::create(grid, M, &why_tri)) return t;
+  return SpectralSolver::create(grid, M, why);
+}
+
+// The exact solve of species s: as auto_exact_solve (auto), tridiagonal along the slowest axis
+// (tridiagonal: an error where it does not apply) or the full transform (fft); null and *why if
+// none.
 std::unique_ptr<ExactSolve> DiffusionSolver::exact_for(int s, const std::string& slow,
                                                        std::string* why) {
-  int size = 1;
-  MPI_Comm_size(grid_.comm(), &size);
-  const bool full_first = slow == "fft" || (slow == "auto" && size == 1 && grid_.dim() == 3);
+  if (slow == "auto") return auto_exact_solve(grid_, ops_.M(s), why);
   std::string why_tri;
-  if (!full_first)
+  if (slow == "tridiagonal") {
     if (auto t = TridiagonalSolver::create(grid_, ops_.M(s), &why_tri)) return t;
-  if (slow == "tridiagonal")
     throw UserError("-diffusion_slow_axis tridiagonal: species " + species_[s] + ": " + why_tri +
                     "; allowed here: auto or fft");
+  }
   return SpectralSolver::create(grid_, ops_.M(s), why);
 }
 

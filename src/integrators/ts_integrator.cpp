@@ -1,5 +1,6 @@
 #include "integrators/ts_integrator.hpp"
 
+#include "integrators/diffusion_solver.hpp"
 #include "integrators/ksp_defaults.hpp"
 
 #include "core/log_events.hpp"
@@ -30,8 +31,9 @@ struct QuietPetscErrors {
 TsIntegrator::TsIntegrator(const Grid& grid, const Halo& halo,
                            const std::vector<std::string>& species, const TermList& terms,
                            const OperatorMatrices* ops, const std::vector<FaceValues>* dirichlet,
-                           double dt)
-    : grid_(grid), halo_(halo), species_(species), terms_(terms), ops_(ops), dirichlet_(dirichlet) {
+                           double dt, const std::string& solver)
+    : grid_(grid), halo_(halo), species_(species), terms_(terms), ops_(ops), dirichlet_(dirichlet),
+      solver_(solver) {
   ns_ = static_cast<PetscInt>(species.size());
   nloc_ = grid.owned().size();
   terms_.diffusion(static_cast<int>(ns_)); // throws unless one diffusion term per species
@@ -244,6 +246,28 @@ void TsIntegrator::setup_implicit_solver(double dt) {
   MG_PETSC(PetscOptionsHasName(nullptr, nullptr, "-ksp_type", &user_ksp));
   MG_PETSC(PetscOptionsHasName(nullptr, nullptr, "-pc_type", &user_pc));
   if (!imex && !user_snes) MG_PETSC(SNESSetType(snes, SNESNEWTONLS));
+  MG_PETSC(fill_jacobian(1.0 / dt));
+  jac_shift_ = -1; // force a refresh on the first call
+  MG_PETSC(KSPSetOperators(ksp, J_, J_));
+  const bool exact = try_exact_pc(ksp);
+  if (!exact) iterative_defaults(ksp, symmetric, user_ksp, user_pc);
+  // Set the linear solver up now, on an operator of the final pattern (set above; its values
+  // are refreshed by the first IJacobian call), so that the parallel default (ICC blocks) can be
+  // installed and every -ksp_/-pc_/-sub_ option is read before the caller checks for unused
+  // options.
+  const std::string err = petsc_quietly([&] { return KSPSetFromOptions(ksp); });
+  if (!err.empty())
+    throw UserError("PETSc options of the TS linear solver (-ksp_*, -pc_*): " + err);
+  if (exact) return;
+  if (symmetric)
+    icc_subblocks(ksp, "-sub_pc_type");
+  else
+    set_up_or_refuse(ksp, "-");
+}
+
+// The iterative solve's defaults (CG + ICC, or GMRES + ILU for a non-symmetric operator;
+// block Jacobi in parallel; rtol 1e-10), each unless the user gave it.
+void TsIntegrator::iterative_defaults(KSP ksp, bool symmetric, bool user_ksp, bool user_pc) {
   int size = 1;
   MPI_Comm_size(grid_.comm(), &size);
   PC pc;
@@ -258,19 +282,46 @@ void TsIntegrator::setup_implicit_solver(double dt) {
   PetscBool user_rtol = PETSC_FALSE;
   MG_PETSC(PetscOptionsHasName(nullptr, nullptr, "-ksp_rtol", &user_rtol));
   if (!user_rtol) MG_PETSC(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, 10000));
-  // Set the linear solver up now, on an operator of the final pattern, so that the parallel
-  // default (ICC blocks) can be installed and every -ksp_/-pc_/-sub_ option is read before the
-  // caller checks for unused options. The values are refreshed by the first IJacobian call.
-  MG_PETSC(fill_jacobian(1.0 / dt));
-  jac_shift_ = -1; // force a refresh on the first call
-  MG_PETSC(KSPSetOperators(ksp, J_, J_));
-  const std::string err = petsc_quietly([&] { return KSPSetFromOptions(ksp); });
-  if (!err.empty())
-    throw UserError("PETSc options of the TS linear solver (-ksp_*, -pc_*): " + err);
-  if (symmetric)
-    icc_subblocks(ksp, "-sub_pc_type");
-  else
-    set_up_or_refuse(ksp, "-");
+}
+
+bool TsIntegrator::try_exact_pc(KSP ksp) {
+  std::string why;
+  bool user = false;
+  for (const char* name :
+       {"-ksp_type", "-pc_type", "-sub_pc_type", "-ksp_rtol", "-ksp_atol", "-ksp_max_it"}) {
+    PetscBool set = PETSC_FALSE;
+    MG_PETSC(PetscOptionsHasName(nullptr, nullptr, name, &set));
+    user = user || set == PETSC_TRUE;
+  }
+  if (solver_ == "ksp")
+    why = "-ts_diffusion_solver ksp";
+  else if (solver_ == "auto" && user)
+    why = "a -ksp_*/-pc_* option was given";
+  else if (timed_)
+    why = "coefficients or boundary values follow t";
+  else if (terms_.any_state_dependent())
+    why = "coefficients follow the state";
+  std::vector<std::unique_ptr<ExactSolve>> solves(static_cast<size_t>(ns_));
+  std::vector<double> scale(static_cast<size_t>(ns_));
+  for (int s = 0; s < ns_ && why.empty(); ++s) {
+    scale[s] = ops_->scale(s);
+    if (scale[s] == 0.0) continue;
+    std::string w = "a non-symmetric operator";
+    if (ops_->symmetric(s)) solves[s] = auto_exact_solve(grid_, ops_->M(s), &w);
+    if (!solves[s]) why = "species " + species_[s] + ": " + w;
+  }
+  if (!why.empty()) {
+    if (solver_ == "spectral")
+      throw UserError("-ts_diffusion_solver spectral: " + why + "; allowed here: ksp or auto");
+    PetscPrintf(grid_.comm(), "  TS diffusion solve: ksp (%s)\n", why.c_str());
+    return false;
+  }
+  exact_pc_ = std::make_unique<TsExactPc>(grid_, std::move(solves), scale, &jac_shift_);
+  exact_pc_->install(ksp);
+  for (int s = 0; s < ns_; ++s)
+    PetscPrintf(grid_.comm(), "  TS diffusion solve of %s: %s, the exact inverse (preonly)\n",
+                species_[s].c_str(), exact_pc_->method(s).c_str());
+  return true;
 }
 
 // ---- PETSc callbacks: no exception may leave them -------------------------------------------

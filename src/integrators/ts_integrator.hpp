@@ -35,9 +35,15 @@
 //     them the default becomes -snes_type newtonls, with the diffusion-only Jacobian (modified
 //     Newton, converging at a rate ~ dt |dR/du|). Explicit types (euler, rk, ssp) are refused
 //     unless -ts_diffusion explicit (then the default is -ts_type rk, PETSc's 3bs).
-//   -ksp_type cg, -pc_type icc on one rank / bjacobi with icc blocks in parallel (unless
+//   -ts_diffusion_solver auto: where every diffusing species' operator has an exact solve
+//     (constant coefficients on periodic / zero-flux / Dirichlet axes, checked numerically:
+//     operators/spectral_solver.hpp, tridiagonal_solver.hpp), no coefficient follows t or the
+//     state, and no -ksp_type, -pc_type, -sub_pc_type, -ksp_rtol, -ksp_atol or -ksp_max_it is
+//     given: -ksp_type preonly with the exact inverse of J as the preconditioner
+//     (integrators/ts_exact_pc.hpp), one application per stage. Elsewhere (and with ksp):
+//     -ksp_type cg, -pc_type icc on one rank / bjacobi with icc blocks in parallel (unless
 //     -sub_pc_type is given), -ksp_rtol 1e-10; GMRES + ILU for non-symmetric operators
-//     (first-order tensor masks).
+//     (first-order tensor masks). The choice is printed at setup.
 // Consecutive step() calls continue one TS integration (multistep schemes keep their history)
 // unless the state or the time changed in between (the clamp floor acted, or a restart): then
 // the step is restarted (TSRestartStep).
@@ -50,10 +56,12 @@
 #pragma once
 
 #include "integrators/integrator.hpp"
+#include "integrators/ts_exact_pc.hpp"
 #include "operators/operator_matrices.hpp"
 #include "operators/term_list.hpp"
 
 #include <exception>
+#include <memory>
 #include <petscts.h>
 #include <string>
 #include <vector>
@@ -68,7 +76,8 @@ public:
   // keeps references to grid, halo, terms, ops and dirichlet.
   TsIntegrator(const Grid& grid, const Halo& halo, const std::vector<std::string>& species,
                const TermList& terms, const OperatorMatrices* ops,
-               const std::vector<FaceValues>* dirichlet, double dt);
+               const std::vector<FaceValues>* dirichlet, double dt,
+               const std::string& solver = "auto");
   TsIntegrator(const TsIntegrator&) = delete;
   TsIntegrator& operator=(const TsIntegrator&) = delete;
 
@@ -101,6 +110,10 @@ private:
   void at_time(double t);
   void setup_ts(double dt);
   void setup_implicit_solver(double dt);
+  // -ts_diffusion_solver: installs the exact preconditioner on ksp where it applies (true), or
+  // says why not (false; an error with spectral).
+  bool try_exact_pc(KSP ksp);
+  void iterative_defaults(KSP ksp, bool symmetric, bool user_ksp, bool user_pc);
   void check_type();
   // Owned cells between the ghosted local state and X; into X it returns whether any value
   // differed from X's (this rank).
@@ -116,13 +129,15 @@ private:
   HaloNeed rhs_halo_;
   PetscInt ns_ = 0, nloc_ = 0;
 
-  DMH dm_;                   // DMDA with one dof per species
-  VecH X_, bD_;              // state; interlaced scale_s b_s (Dirichlet data)
-  bool has_b_ = false;       // any Dirichlet data at all
-  MatH Dblock_;              // K without b
-  MatH J_;                   // shift I - K
-  PetscReal jac_shift_ = -1; // shift J_ holds (-1: stale)
-  TSH ts_;                   // destroyed before the matrices and DM it uses
+  DMH dm_;                              // DMDA with one dof per species
+  VecH X_, bD_;                         // state; interlaced scale_s b_s (Dirichlet data)
+  bool has_b_ = false;                  // any Dirichlet data at all
+  MatH Dblock_;                         // K without b
+  MatH J_;                              // shift I - K
+  PetscReal jac_shift_ = -1;            // shift J_ holds (-1: stale)
+  std::string solver_;                  // -ts_diffusion_solver
+  std::unique_ptr<TsExactPc> exact_pc_; // the shell PC's context: outlives ts_
+  TSH ts_;                              // destroyed before the matrices and DM it uses
   bool adaptive_ = false;
   double next_dt_ = 0; // the adaptive controller's proposal for the next internal step
   bool solved_ = false;
