@@ -49,6 +49,7 @@ PetscErrorCode TsExactPc::apply_cb(PC pc, Vec r, Vec z) {
 // z = J^-1 r, species by species: de-interlace r_s, solve, re-interlace z_s.
 void TsExactPc::apply(Vec r, Vec z) {
   const double shift = *shift_;
+  if (!(shift > 0.0)) throw std::logic_error("TsExactPc: no IJacobian shift yet");
   const PetscScalar* ra = nullptr;
   PetscScalar* za = nullptr;
   MG_PETSC(VecGetArrayRead(r, &ra));

@@ -297,8 +297,8 @@ bool TsIntegrator::try_exact_pc(KSP ksp) {
     why = "-ts_diffusion_solver ksp";
   else if (solver_ == "auto" && user)
     why = "a -ksp_*/-pc_* option was given";
-  else if (timed_)
-    why = "coefficients or boundary values follow t";
+  else if (terms_.any_timed_coefficients())
+    why = "coefficients follow t";
   else if (terms_.any_state_dependent())
     why = "coefficients follow the state";
   std::vector<std::unique_ptr<ExactSolve>> solves(static_cast<size_t>(ns_));
@@ -316,7 +316,7 @@ bool TsIntegrator::try_exact_pc(KSP ksp) {
     PetscPrintf(grid_.comm(), "  TS diffusion solve: ksp (%s)\n", why.c_str());
     return false;
   }
-  exact_pc_ = std::make_unique<TsExactPc>(grid_, std::move(solves), scale, &jac_shift_);
+  exact_pc_ = std::make_unique<TsExactPc>(grid_, std::move(solves), scale, &pc_shift_);
   exact_pc_->install(ksp);
   for (int s = 0; s < ns_; ++s)
     PetscPrintf(grid_.comm(), "  TS diffusion solve of %s: %s, the exact inverse (preonly)\n",
@@ -439,6 +439,7 @@ PetscErrorCode TsIntegrator::ijacobian(PetscReal shift, Mat A, Mat P) {
              "TsIntegrator: unexpected preconditioning matrix");
   // Only this class writes J (no RHS Jacobian is registered, so TS never adds to it).
   if (shift != jac_shift_) PetscCall(fill_jacobian(shift));
+  pc_shift_ = shift; // the exact preconditioner inverts this J (also when J is lagged)
   if (A != P) {
     PetscCall(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY));
     PetscCall(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY));

@@ -37,11 +37,11 @@
 //     unless -ts_diffusion explicit (then the default is -ts_type rk, PETSc's 3bs).
 //   -ts_diffusion_solver auto: where every diffusing species' operator has an exact solve
 //     (constant coefficients on periodic / zero-flux / Dirichlet axes, checked numerically:
-//     operators/spectral_solver.hpp, tridiagonal_solver.hpp), no coefficient follows t or the
-//     state, and no -ksp_type, -pc_type, -sub_pc_type, -ksp_rtol, -ksp_atol or -ksp_max_it is
-//     given: -ksp_type preonly with the exact inverse of J as the preconditioner
-//     (integrators/ts_exact_pc.hpp), one application per stage. Elsewhere (and with ksp):
-//     -ksp_type cg, -pc_type icc on one rank / bjacobi with icc blocks in parallel (unless
+//     operators/spectral_solver.hpp, tridiagonal_solver.hpp; Dirichlet values may follow t),
+//     no coefficient follows t or the state, and no -ksp_type, -pc_type, -sub_pc_type, -ksp_rtol,
+//     -ksp_atol or -ksp_max_it is given: -ksp_type preonly with the exact inverse of J as the
+//     preconditioner (integrators/ts_exact_pc.hpp), one application per stage. Elsewhere (and with
+//     ksp): -ksp_type cg, -pc_type icc on one rank / bjacobi with icc blocks in parallel (unless
 //     -sub_pc_type is given), -ksp_rtol 1e-10; GMRES + ILU for non-symmetric operators
 //     (first-order tensor masks). The choice is printed at setup.
 // Consecutive step() calls continue one TS integration (multistep schemes keep their history)
@@ -135,6 +135,7 @@ private:
   MatH Dblock_;                         // K without b
   MatH J_;                              // shift I - K
   PetscReal jac_shift_ = -1;            // shift J_ holds (-1: stale)
+  PetscReal pc_shift_ = 1;              // shift of the last IJacobian (the exact preconditioner's)
   std::string solver_;                  // -ts_diffusion_solver
   std::unique_ptr<TsExactPc> exact_pc_; // the shell PC's context: outlives ts_
   TSH ts_;                              // destroyed before the matrices and DM it uses

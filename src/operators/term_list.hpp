@@ -54,6 +54,9 @@ public:
   void use_boundary(DirichletValues* b) { boundary_ = b && b->time_dependent() ? b : nullptr; }
   // True when some coefficient or boundary value depends on t.
   bool any_time_dependent() const { return timed_ || boundary_; }
+  // Some diffusion or other coefficient follows t (Dirichlet values alone do not count: they
+  // change the matrices' b, not the matrices).
+  bool any_timed_coefficients() const { return timed_; }
   // Evaluate the time-dependent coefficients (Term::set_time) and Dirichlet values at t; the
   // matrices given to use_matrices (if any) follow: re-assembled for the species whose
   // operator changed (appended to `changed` when given), their Dirichlet vectors b_s

@@ -2,7 +2,7 @@
 (-ts_diffusion_solver auto|spectral: integrators/ts_exact_pc.hpp, KSP preonly) against the
 iterative solve (-ts_diffusion_solver ksp, CG + ICC at -ksp_rtol 1e-13): the same fields to
 1e-12 of their size (rounding: a relative error of 1e-7 in the inverse fails it) after 20 steps of 2-D and 3-D grids with periodic, zero-flux and Dirichlet
-boundaries, 5-, 9- and 19-point stencils, a rotated constant tensor, an adaptive step and a fully implicit (BDF, Newton)
+boundaries (Dirichlet values also following t), 5-, 9- and 19-point stencils, a rotated constant tensor, an adaptive step and a fully implicit (BDF, Newton)
 scheme, on 1, 2 and 4 ranks; the rank counts agree with each other to 1e-12. Where the exact
 solve does not apply (a diffusion map) auto falls back to KSP and says why; spectral is then a
 one-line error, as is the option without -integrator ts."""
@@ -25,6 +25,8 @@ CASES = {
     "neumann_9pt": [DECK, "-grid_n", "40,36", "-grid_bc", "neumann", "-stencil", "9pt"],
     "dirichlet_mixed": [DECK, "-grid_n", "32,30", "-grid_bc", "periodic,dirichlet",
                         "-dirichlet_a", "4 + 0.1*x"],
+    "dirichlet_timed": [DECK, "-grid_n", "30,28", "-grid_bc", "dirichlet",
+                        "-dirichlet_b", "4 + 0.2*sin(0.1*t) + 0.01*y"],  # b follows t, M does not
     "neumann_3d_19pt": [DECK_3D, "-grid_n", "10,9,8", "-grid_bc", "neumann", "-stencil", "19pt"],
     "tensor_periodic": [DECK, "-grid_n", "36,32", "-diffusion", "tensor", "-tensor_theta", "0.3",
                         "-tensor_l1", "1.5", "-tensor_l2", "0.5"],  # cross terms: complex DFT
