@@ -376,8 +376,8 @@ void Simulation::read_time(Options& opt) {
         "preconditioner of -ksp_type preonly: periodic, zero-flux or Dirichlet axes, "
         "constant coefficients), ksp (-ksp_type/-pc_type; default CG with ICC), or auto (spectral "
         "where "
-        "it applies and no -ksp_type, -pc_type, -sub_pc_type, -ksp_rtol, -ksp_atol or "
-        "-ksp_max_it is given)");
+        "it applies and no -ksp_type, -pc_type, -sub_pc_type, -ksp_rtol, -ksp_atol, "
+        "-ksp_max_it, -ksp_initial_guess_nonzero or -snes_mf is given)");
   else if (opt.is_set("ts_diffusion_solver"))
     throw UserError("-ts_diffusion_solver: applies to -integrator ts with -ts_diffusion "
                     "implicit only");

@@ -5,8 +5,8 @@
 namespace morphogen {
 
 TsExactPc::TsExactPc(const Grid& grid, std::vector<std::unique_ptr<ExactSolve>> solves,
-                     std::vector<double> scale, const PetscReal* shift)
-    : solves_(std::move(solves)), scale_(std::move(scale)), shift_(shift) {
+                     std::vector<double> scale, const PetscReal* shift, std::exception_ptr* error)
+    : solves_(std::move(solves)), scale_(std::move(scale)), shift_(shift), error_(error) {
   ns_ = static_cast<PetscInt>(solves_.size());
   if (static_cast<PetscInt>(scale_.size()) != ns_)
     throw std::logic_error("TsExactPc: one scale per species");
@@ -36,12 +36,14 @@ PetscErrorCode TsExactPc::apply_cb(PC pc, Vec r, Vec z) {
   PetscFunctionBeginUser;
   void* ctx = nullptr;
   PetscCall(PCShellGetContext(pc, &ctx));
+  auto* self = static_cast<TsExactPc*>(ctx);
   try {
-    static_cast<TsExactPc*>(ctx)->apply(r, z);
-  } catch (const PetscFailure& e) {
+    self->apply(r, z);
+  } catch (const PetscFailure& e) { // PETSc has printed its trace
     return e.code;
-  } catch (...) { // no exception may cross PETSc's C code
-    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_LIB, "morphogen: exact diffusion preconditioner failed");
+  } catch (...) { // kept for the integrator (no exception may cross PETSc's C code)
+    if (self->error_) *self->error_ = std::current_exception();
+    return PETSC_ERR_LIB;
   }
   PetscFunctionReturn(0);
 }
@@ -50,6 +52,9 @@ PetscErrorCode TsExactPc::apply_cb(PC pc, Vec r, Vec z) {
 void TsExactPc::apply(Vec r, Vec z) {
   const double shift = *shift_;
   if (!(shift > 0.0)) throw std::logic_error("TsExactPc: no IJacobian shift yet");
+  PetscInt n = 0;
+  MG_PETSC(VecGetLocalSize(r, &n));
+  if (n != ns_ * nloc_) throw std::logic_error("TsExactPc: not the interlaced state's layout");
   const PetscScalar* ra = nullptr;
   PetscScalar* za = nullptr;
   MG_PETSC(VecGetArrayRead(r, &ra));

@@ -14,6 +14,7 @@
 #include "grid/grid.hpp"
 #include "operators/exact_solve.hpp"
 
+#include <exception>
 #include <memory>
 #include <petscksp.h>
 #include <vector>
@@ -23,9 +24,10 @@ namespace morphogen {
 class TsExactPc {
 public:
   // solves[s]: species s's exact solve (null only where scale[s] == 0); shift: where the
-  // integrator keeps the IJacobian's shift.
+  // integrator keeps the IJacobian's shift; error: where an exception of an application is
+  // kept for the integrator to rethrow after the solve (none may cross PETSc's C code).
   TsExactPc(const Grid& grid, std::vector<std::unique_ptr<ExactSolve>> solves,
-            std::vector<double> scale, const PetscReal* shift);
+            std::vector<double> scale, const PetscReal* shift, std::exception_ptr* error);
   TsExactPc(const TsExactPc&) = delete;
   TsExactPc& operator=(const TsExactPc&) = delete;
 
@@ -41,6 +43,7 @@ private:
   std::vector<std::unique_ptr<ExactSolve>> solves_;
   std::vector<double> scale_;
   const PetscReal* shift_;
+  std::exception_ptr* error_;
   PetscInt ns_ = 0, nloc_ = 0;
   VecH rs_, zs_; // one species in the grid's global layout
 };

@@ -258,11 +258,28 @@ void TsIntegrator::setup_implicit_solver(double dt) {
   const std::string err = petsc_quietly([&] { return KSPSetFromOptions(ksp); });
   if (!err.empty())
     throw UserError("PETSc options of the TS linear solver (-ksp_*, -pc_*): " + err);
-  if (exact) return;
+  if (exact) {
+    check_exact_kept(ksp);
+    return;
+  }
   if (symmetric)
     icc_subblocks(ksp, "-sub_pc_type");
   else
     set_up_or_refuse(ksp, "-");
+}
+
+// After KSPSetFromOptions: the exact inverse is still the solver (no option replaced it).
+void TsIntegrator::check_exact_kept(KSP ksp) {
+  KSPType kt = nullptr;
+  PCType pt = nullptr;
+  PC pc;
+  MG_PETSC(KSPGetType(ksp, &kt));
+  MG_PETSC(KSPGetPC(ksp, &pc));
+  MG_PETSC(PCGetType(pc, &pt));
+  if (std::string(kt) != KSPPREONLY || std::string(pt) != PCSHELL)
+    throw UserError(std::string("-ts_diffusion_solver ") + solver_ +
+                    ": the linear-solver options replaced the exact inverse (KSP " + kt + ", PC " +
+                    pt + "); with them use -ts_diffusion_solver ksp");
 }
 
 // The iterative solve's defaults (CG + ICC, or GMRES + ILU for a non-symmetric operator;
@@ -284,23 +301,25 @@ void TsIntegrator::iterative_defaults(KSP ksp, bool symmetric, bool user_ksp, bo
   if (!user_rtol) MG_PETSC(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, 10000));
 }
 
-bool TsIntegrator::try_exact_pc(KSP ksp) {
-  std::string why;
-  bool user = false;
-  for (const char* name :
-       {"-ksp_type", "-pc_type", "-sub_pc_type", "-ksp_rtol", "-ksp_atol", "-ksp_max_it"}) {
+// Why the exact preconditioner cannot serve this run ("" when it can): -ts_diffusion_solver
+// ksp, a linear-solver option that asks for another method (or a nonzero initial guess, which
+// preonly refuses), a matrix-free Jacobian (-snes_mf: the IJacobian, and with it the shift,
+// never comes), or coefficients that change the matrices during the run.
+std::string TsIntegrator::exact_pc_blocker() const {
+  if (solver_ == "ksp") return "-ts_diffusion_solver ksp";
+  for (const char* name : {"-ksp_type", "-pc_type", "-sub_pc_type", "-ksp_rtol", "-ksp_atol",
+                           "-ksp_max_it", "-ksp_initial_guess_nonzero", "-snes_mf"}) {
     PetscBool set = PETSC_FALSE;
     MG_PETSC(PetscOptionsHasName(nullptr, nullptr, name, &set));
-    user = user || set == PETSC_TRUE;
+    if (set) return std::string(name) + " was given";
   }
-  if (solver_ == "ksp")
-    why = "-ts_diffusion_solver ksp";
-  else if (solver_ == "auto" && user)
-    why = "a -ksp_*/-pc_* option was given";
-  else if (terms_.any_timed_coefficients())
-    why = "coefficients follow t";
-  else if (terms_.any_state_dependent())
-    why = "coefficients follow the state";
+  if (terms_.any_timed_coefficients()) return "coefficients follow t";
+  if (terms_.any_state_dependent()) return "coefficients follow the state";
+  return "";
+}
+
+bool TsIntegrator::try_exact_pc(KSP ksp) {
+  std::string why = exact_pc_blocker();
   std::vector<std::unique_ptr<ExactSolve>> solves(static_cast<size_t>(ns_));
   std::vector<double> scale(static_cast<size_t>(ns_));
   for (int s = 0; s < ns_ && why.empty(); ++s) {
@@ -316,7 +335,8 @@ bool TsIntegrator::try_exact_pc(KSP ksp) {
     PetscPrintf(grid_.comm(), "  TS diffusion solve: ksp (%s)\n", why.c_str());
     return false;
   }
-  exact_pc_ = std::make_unique<TsExactPc>(grid_, std::move(solves), scale, &pc_shift_);
+  exact_pc_ =
+      std::make_unique<TsExactPc>(grid_, std::move(solves), scale, &pc_shift_, &callback_error_);
   exact_pc_->install(ksp);
   for (int s = 0; s < ns_; ++s)
     PetscPrintf(grid_.comm(), "  TS diffusion solve of %s: %s, the exact inverse (preonly)\n",

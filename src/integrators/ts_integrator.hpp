@@ -113,6 +113,8 @@ private:
   // -ts_diffusion_solver: installs the exact preconditioner on ksp where it applies (true), or
   // says why not (false; an error with spectral).
   bool try_exact_pc(KSP ksp);
+  std::string exact_pc_blocker() const;
+  void check_exact_kept(KSP ksp);
   void iterative_defaults(KSP ksp, bool symmetric, bool user_ksp, bool user_pc);
   void check_type();
   // Owned cells between the ghosted local state and X; into X it returns whether any value
@@ -129,14 +131,14 @@ private:
   HaloNeed rhs_halo_;
   PetscInt ns_ = 0, nloc_ = 0;
 
-  DMH dm_;                              // DMDA with one dof per species
-  VecH X_, bD_;                         // state; interlaced scale_s b_s (Dirichlet data)
-  bool has_b_ = false;                  // any Dirichlet data at all
-  MatH Dblock_;                         // K without b
-  MatH J_;                              // shift I - K
-  PetscReal jac_shift_ = -1;            // shift J_ holds (-1: stale)
-  PetscReal pc_shift_ = 1;              // shift of the last IJacobian (the exact preconditioner's)
-  std::string solver_;                  // -ts_diffusion_solver
+  DMH dm_;                   // DMDA with one dof per species
+  VecH X_, bD_;              // state; interlaced scale_s b_s (Dirichlet data)
+  bool has_b_ = false;       // any Dirichlet data at all
+  MatH Dblock_;              // K without b
+  MatH J_;                   // shift I - K
+  PetscReal jac_shift_ = -1; // shift J_ holds (-1: stale)
+  PetscReal pc_shift_ = 0;   // shift of the last IJacobian (the exact preconditioner's; 0: none)
+  std::string solver_;       // -ts_diffusion_solver
   std::unique_ptr<TsExactPc> exact_pc_; // the shell PC's context: outlives ts_
   TSH ts_;                              // destroyed before the matrices and DM it uses
   bool adaptive_ = false;

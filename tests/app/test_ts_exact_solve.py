@@ -3,9 +3,10 @@
 iterative solve (-ts_diffusion_solver ksp, CG + ICC at -ksp_rtol 1e-13): the same fields to
 1e-12 of their size (rounding: a relative error of 1e-7 in the inverse fails it) after 20 steps of 2-D and 3-D grids with periodic, zero-flux and Dirichlet
 boundaries (Dirichlet values also following t), 5-, 9- and 19-point stencils, a rotated constant tensor, an adaptive step and a fully implicit (BDF, Newton)
-scheme, on 1, 2 and 4 ranks; the rank counts agree with each other to 1e-12. Where the exact
-solve does not apply (a diffusion map) auto falls back to KSP and says why; spectral is then a
-one-line error, as is the option without -integrator ts."""
+scheme (BDF and CN: Newton), ROSW and a species without diffusion, on 1, 2 and 4 ranks; the rank
+counts agree with each other to 1e-12. Where the exact solve does not apply (a diffusion map,
+pinned cells, coefficients following t, a linear-solver option, -snes_mf) auto falls back to KSP
+and says why; spectral is then a one-line error, as is the option without -integrator ts."""
 import glob
 import os
 
@@ -32,6 +33,9 @@ CASES = {
                         "-tensor_l1", "1.5", "-tensor_l2", "0.5"],  # cross terms: complex DFT
     "adaptive": [DECK, "-grid_n", "40,40", "-ts_adapt_type", "basic", "-dt", "4"],
     "bdf_newton": [DECK, "-grid_n", "32,32", "-ts_type", "bdf", "-dt", "1"],
+    "rosw": [DECK, "-grid_n", "32,30", "-ts_type", "rosw"],
+    "cn_newton": [DECK, "-grid_n", "30,32", "-ts_type", "cn", "-dt", "1"],
+    "b_not_diffusing": [DECK, "-grid_n", "32,32", "-D_b", "0"],  # r / shift for that species
 }
 
 
@@ -44,7 +48,8 @@ def final_state(out):
 
 def ts_run(tmp_path, tag, args, ranks):
     out = str(tmp_path / tag)
-    p = run(args + COMMON + ["-output_dir", out], tmp_path, ranks)
+    # The deck, the common options, then the case's (a case's -dt overrides the common one).
+    p = run(args[:1] + COMMON + args[1:] + ["-output_dir", out], tmp_path, ranks)
     assert p.returncode == 0, p.stdout + p.stderr
     return p.stdout, final_state(out)
 
@@ -76,14 +81,25 @@ def test_fallbacks_and_errors(tmp_path):
     varying = [DECK, "-grid_n", "32,32", "-D_a", "0.0625*(1 + 0.5*x/Lx)"]
     log, _ = ts_run(tmp_path, "map", varying, 1)
     assert "TS diffusion solve: ksp (species a:" in log, log
-    log, _ = ts_run(tmp_path, "user_pc", [DECK, "-grid_n", "32,32", "-pc_type", "jacobi"], 1)
-    assert "TS diffusion solve: ksp (a -ksp_*/-pc_* option was given)" in log, log
+    fallbacks = {
+        "-pc_type was given": ["-pc_type", "jacobi"],
+        "-snes_mf was given": ["-snes_mf"],  # no IJacobian, so no shift for the inverse
+        "-ksp_initial_guess_nonzero was given": ["-ksp_initial_guess_nonzero"],
+        "coefficients follow t": ["-D_a", "0.0625*(1 + 0.1*sin(t))"],
+        "species b:": ["-pin_b", "j < 2"],
+    }
+    for i, (why, extra) in enumerate(fallbacks.items()):
+        log, _ = ts_run(tmp_path, "fallback%d" % i, [DECK, "-grid_n", "32,32"] + extra, 1)
+        assert "TS diffusion solve: ksp (" + why in log, log
     bad = [
-        (varying + COMMON + ["-ts_diffusion_solver", "spectral"],
+        ([varying[0]] + COMMON + varying[1:] + ["-ts_diffusion_solver", "spectral"],
          ["-ts_diffusion_solver spectral: species a:", "allowed here: ksp or auto"]),
+        ([DECK] + COMMON + ["-grid_n", "32,32", "-ts_diffusion_solver", "spectral", "-pc_type",
+                            "jacobi"],
+         ["-ts_diffusion_solver spectral: -pc_type was given", "allowed here: ksp or auto"]),
         ([DECK, "-grid_n", "32,32", "-steps", "2", "-ts_diffusion_solver", "spectral"],
          ["-ts_diffusion_solver", "applies to -integrator ts"]),
-        ([DECK, "-grid_n", "32,32"] + COMMON + ["-ts_diffusion_solver", "fft"],
+        ([DECK] + COMMON + ["-grid_n", "32,32", "-ts_diffusion_solver", "fft"],
          ["-ts_diffusion_solver", "fft", "auto, ksp, spectral"]),
     ]
     for args, needles in bad:
