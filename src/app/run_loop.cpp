@@ -4,6 +4,7 @@
 #include "core/collective_error.hpp"
 #include "core/log_events.hpp"
 #include "core/user_error.hpp"
+#include "integrators/kernel_choice.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -94,6 +95,9 @@ bool run_loop(Simulation& sim, PetscInt end_step, RunOutput& output, PngOutput& 
     PetscPrintf(comm, "fused steps: %lld steps in %lld passes (up to %lld steps each)\n",
                 static_cast<long long>(steps), static_cast<long long>(passes),
                 static_cast<long long>(std::min(sim.fuse_steps(), steps)));
+  const std::string width = sim.explicit_vector_width();
+  if (!width.empty() && wide_vectors_available())
+    PetscPrintf(comm, "explicit kernel (rank 0): %s\n", width.c_str());
   if (final_level) {
     check_finite();
     std::snprintf(tag, sizeof tag, "%07lld", static_cast<long long>(sim.step_index()));

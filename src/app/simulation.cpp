@@ -648,7 +648,7 @@ void Simulation::step() {
 void Simulation::read_fuse(Options& opt) {
   const char* key = "explicit_fuse_steps";
   if (split_ || ts_) {
-    for (const char* k : {key, "explicit_in_place", "explicit_fuse_tile"})
+    for (const char* k : {key, "explicit_in_place", "explicit_fuse_tile", "explicit_vector_width"})
       if (opt.is_set(k))
         throw UserError(std::string("-") + k + ": applies to -integrator explicit only");
     if (split_fuse_) read_split_fuse();
@@ -671,11 +671,36 @@ void Simulation::read_fuse(Options& opt) {
   integrator_->set_in_place(in_place == "yes"  ? ExplicitIntegrator::InPlace::Always
                             : in_place == "no" ? ExplicitIntegrator::InPlace::Never
                                                : ExplicitIntegrator::InPlace::Auto);
+  read_vector_width(opt);
   const std::string why = fuse_blocker(integrator_->fuse_unsupported());
   fuse_ = why.empty() ? k : 1;
   if (k > 1 && !why.empty())
     PetscPrintf(comm_, "explicit_fuse_steps %lld: fused steps need %s; one step per pass\n",
                 static_cast<long long>(k), why.c_str());
+}
+
+// -explicit_vector_width auto|256|512: which compile of the fused row kernel the explicit
+// fast path runs (the same results; auto: the faster in the first passes, timed per rank).
+void Simulation::read_vector_width(Options& opt) {
+  const std::string w = opt.choice(
+      "explicit_vector_width", "auto", {"auto", "256", "512"},
+      "explicit fast path: the row kernel compiled with 256- or 512-bit vectors (the same "
+      "results); auto: each rank times both in its first passes and keeps the faster (512 "
+      "only where the build's CPU has AVX-512)");
+  const ModelKernels& mk = model_->kernels;
+  RowStencil rows;
+  to_rows(stencil_, rows);
+  const ExplicitIntegrator::RowFn wide =
+      mk.fused ? mk.row_kernel(params_.any_field(), rows.nrows, rows.box, true) : nullptr;
+  integrator_->set_vector_width(w == "256"   ? KernelChoice::Mode::Narrow
+                                : w == "512" ? KernelChoice::Mode::Wide
+                                             : KernelChoice::Mode::Auto,
+                                wide);
+}
+
+std::string Simulation::explicit_vector_width() const {
+  if (split_ || ts_ || integrator_->general() || !model_->kernels.fused) return "";
+  return integrator_->vector_width();
 }
 
 // -split_fuse_reaction: fused Strang passes as long as nothing observes the state (the run loop

@@ -106,6 +106,9 @@ public:
   const AdvectionStage* advection() const { return advection_.get(); }
   // The stable-fluids solver run before the advection stage each step (-fluid), or null.
   FluidSolver* fluid() const { return fluid_.get(); }
+  // The explicit fast path's row kernel compile on this rank ("512-bit (least pass ...)"; see
+  // -explicit_vector_width), or "" where the run does not use it.
+  std::string explicit_vector_width() const;
   // Make ghosts current (after initialisation or before reading neighbours).
   void refresh_ghosts() { integrator_->update_ghosts(u_); }
   // Collective: throws UserError naming species, cell, step and time if any value is NaN/Inf.
@@ -113,6 +116,7 @@ public:
 
 private:
   void read_fuse(Options& opt);
+  void read_vector_width(Options& opt);
   void read_split_fuse();
   std::string fuse_blocker(std::string why) const;
   static constexpr PetscInt kMaxFusedSplitSteps = 1 << 20; // a pass ends at any observation

@@ -2,6 +2,7 @@
 
 #include <petscdmda.h>
 
+#include <algorithm>
 #include <cstring>
 
 namespace morphogen {
@@ -88,18 +89,50 @@ Halo::Halo(const Grid& grid) : grid_(grid) {
 
 void Halo::split_runs(const std::vector<PetscInt>& ghost, const std::vector<PetscInt>& source) {
   const size_t n = ghost.size();
+  std::vector<PetscInt> g, src; // not in a block run
   for (size_t q = 0; q < n;) {
     size_t e = q + 1;
     while (e < n && ghost[e] == ghost[e - 1] + 1 && source[e] == source[e - 1] + 1)
       ++e;
     const PetscInt len = static_cast<PetscInt>(e - q);
     if (len >= kMinRun) {
-      runs_.push_back({ghost[q], source[q], len});
+      runs_.push_back({ghost[q], source[q], len, 1});
     } else {
-      ghost_.insert(ghost_.end(), ghost.begin() + q, ghost.begin() + e);
-      source_.insert(source_.end(), source.begin() + q, source.begin() + e);
+      g.insert(g.end(), ghost.begin() + q, ghost.begin() + e);
+      src.insert(src.end(), source.begin() + q, source.begin() + e);
     }
     q = e;
+  }
+  split_strided(std::move(g), std::move(src));
+}
+
+// The ghosts of split_runs that are in no block run, grouped by their offset source - ghost
+// and ordered by position: arithmetic progressions of at least kMinRun become strided runs.
+void Halo::split_strided(std::vector<PetscInt> ghost, std::vector<PetscInt> source) {
+  std::vector<size_t> order(ghost.size());
+  for (size_t q = 0; q < order.size(); ++q)
+    order[q] = q;
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    const PetscInt da = source[a] - ghost[a], db = source[b] - ghost[b];
+    return da != db ? da < db : ghost[a] < ghost[b];
+  });
+  auto same_run = [&](size_t a, size_t b, PetscInt stride) { // b follows a in a run
+    return source[b] - ghost[b] == source[a] - ghost[a] && ghost[b] - ghost[a] == stride;
+  };
+  for (size_t q = 0; q < order.size();) {
+    size_t e = q + 1;
+    const PetscInt stride = e < order.size() ? ghost[order[e]] - ghost[order[q]] : 0;
+    while (e < order.size() && same_run(order[e - 1], order[e], stride))
+      ++e;
+    const PetscInt len = static_cast<PetscInt>(e - q);
+    if (len >= kMinRun) {
+      strided_.push_back({ghost[order[q]], source[order[q]], len, stride});
+      q = e;
+      continue;
+    }
+    ghost_.push_back(ghost[order[q]]); // one by one; the next may start a run
+    source_.push_back(source[order[q]]);
+    ++q;
   }
 }
 
@@ -107,6 +140,12 @@ void Halo::begin(double* a) const {
   if (local_only_) { // sources are owned cells: order does not matter
     for (const Run& r : runs_)
       std::memcpy(a + r.ghost, a + r.source, sizeof(double) * r.len);
+    for (const Run& r : strided_) {
+      double* __restrict__ g = a + r.ghost;
+      const double* __restrict__ s = a + r.source;
+      for (PetscInt q = 0, o = 0; q < r.len; ++q, o += r.stride)
+        g[o] = s[o];
+    }
     const PetscInt n = static_cast<PetscInt>(ghost_.size());
     const PetscInt* __restrict__ g = ghost_.data();
     const PetscInt* __restrict__ s = source_.data();

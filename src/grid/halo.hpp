@@ -57,14 +57,17 @@ private:
   // On a one-rank communicator (a sweep point, a serial run) the periodic ghosts are copied
   // directly, without PetscSF's pack/unpack and call overhead (a quarter of a 64^2 explicit
   // step): runs of at least kMinRun consecutive ghosts with consecutive sources (whole ghost
-  // rows) as block copies, the other ghosts one by one, ghost_[q] <- source_[q].
+  // rows) as block copies; of the others, runs of at least kMinRun ghosts a fixed stride apart
+  // with their sources the same stride apart (ghost columns: the stride is a row) as strided
+  // copies, with no index loads; the rest one by one, ghost_[q] <- source_[q].
   struct Run {
-    PetscInt ghost, source, len;
+    PetscInt ghost, source, len, stride;
   };
   static constexpr PetscInt kMinRun = 8;
   void split_runs(const std::vector<PetscInt>& ghost, const std::vector<PetscInt>& source);
+  void split_strided(std::vector<PetscInt> ghost, std::vector<PetscInt> source);
   bool local_only_ = false;
-  std::vector<Run> runs_;
+  std::vector<Run> runs_, strided_;
   std::vector<PetscInt> ghost_, source_;
 };
 

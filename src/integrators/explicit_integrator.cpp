@@ -3,11 +3,19 @@
 #include "core/log_events.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <exception>
 #include <limits>
 #include <utility>
 
 namespace morphogen {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+} // namespace
 
 ExplicitIntegrator::ExplicitIntegrator(const Grid& grid, const Halo& halo, RowFn row_fn,
                                        int nspecies, const Stencil& stencil, std::vector<double> D,
@@ -213,7 +221,9 @@ void ExplicitIntegrator::steps(std::vector<VecH>& u, double t, double dt, int n)
   row.floor = floor_.data();
   row.pconst = params_.scalar.data();
   row.dt = dt;
-  fused_->run(in, out, n, row, row_fn_);
+  const auto t0 = fused_choice_.timing() ? Clock::now() : Clock::time_point{};
+  fused_->run(in, out, n, row, fused_choice_.next());
+  fused_choice_.record(fused_choice_.timing() ? seconds_since(t0) / n : 0.0);
   for (int s = 0; s < ns_; ++s) {
     MG_PETSC(VecRestoreArrayRead(u[s], &in[s]));
     MG_PETSC(VecRestoreArray(work_[s], &out[s]));
@@ -224,6 +234,13 @@ void ExplicitIntegrator::steps(std::vector<VecH>& u, double t, double dt, int n)
 void ExplicitIntegrator::step(std::vector<VecH>& u, std::vector<VecH>& work, double dt) const {
   update_ghosts(u);
   sweep(u, &work, dt);
+}
+
+std::string ExplicitIntegrator::vector_width() const {
+  const std::string a = sweep_choice_.describe(), b = fused_choice_.describe();
+  if (fused_choice_.runs() == 0) return a;
+  if (sweep_choice_.runs() == 0) return "fused passes " + b;
+  return "single steps " + a + ", fused passes " + b;
 }
 
 bool ExplicitIntegrator::in_place() const {
@@ -284,6 +301,8 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
     return;
   }
   LogScope log_scope(log_events().sweep);
+  const auto t0 = sweep_choice_.timing() ? Clock::now() : Clock::time_point{};
+  const RowFn row_fn = sweep_choice_.next();
   const int nr = rows_.nrows;
   const int np = static_cast<int>(params_.scalar.size());
   const bool field_mode = params_.any_field();
@@ -360,7 +379,7 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
           for (int q = 0; q < np; ++q)
             prow[q] = pf[q] ? pf[q] + o : const_rows_[q].data();
         }
-        row_fn_(row);
+        row_fn(row);
         if (in_place && t >= lag) commit_row(in, t - lag, jb, bh, to_edge);
       }
     if (!in_place) continue;
@@ -377,6 +396,7 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
     if (!in_place) MG_PETSC(VecRestoreArray((*work)[s], &out[s]));
   }
   if (!in_place) std::swap(u, *work);
+  sweep_choice_.record(sweep_choice_.timing() ? seconds_since(t0) : 0.0);
 }
 
 } // namespace morphogen

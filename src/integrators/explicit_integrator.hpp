@@ -38,6 +38,7 @@
 #include "integrators/explicit_kernel.hpp"
 #include "integrators/fused_sweep.hpp"
 #include "integrators/integrator.hpp"
+#include "integrators/kernel_choice.hpp"
 #include "operators/diffusion_operator.hpp"
 #include "operators/term_list.hpp"
 
@@ -86,6 +87,16 @@ public:
   static constexpr double kInPlaceBytes = 8.0 * 1024 * 1024;
   static constexpr double kInPlaceBytes3d = 64.0 * 1024 * 1024;
   void set_in_place(InPlace mode) { in_place_ = mode; }
+
+  // The fast path's second compile of the row kernel (512-bit vectors, the same results) and
+  // how to choose between the two (-explicit_vector_width: timed in the first passes, or forced).
+  void set_vector_width(KernelChoice::Mode mode, RowFn wide_fn) {
+    sweep_choice_ = KernelChoice(row_fn_, wide_fn, mode);
+    fused_choice_ = KernelChoice(row_fn_, wide_fn, mode);
+  }
+  // The kernel the single-step sweeps and the fused passes run ("256-bit", "512-bit", with the
+  // timings where they were chosen by timing).
+  std::string vector_width() const;
 
   // Temporal blocking: up to k >= 1 steps per pass (1: one step per pass, the default).
   void set_fuse_steps(int k) { fuse_request_ = k; }
@@ -171,6 +182,8 @@ private:
   int fuse_request_ = 1;
   PetscInt fuse_tile_ = 0;
   std::unique_ptr<FusedSweep> fused_; // built on the first fused call
+  mutable KernelChoice sweep_choice_{row_fn_, row_fn_, KernelChoice::Mode::Narrow};
+  KernelChoice fused_choice_{row_fn_, row_fn_, KernelChoice::Mode::Narrow};
 };
 
 } // namespace morphogen

@@ -21,7 +21,9 @@
 // loop over i carries `GCC ivdep` (rows never alias); the model's rates() inline into it and GCC
 // vectorises it (configure with -DMORPHOGEN_VEC_REPORT=ON to see "loop vectorized" for this file).
 // (`omp simd` is not used: GCC 12 turns the small per-cell arrays into "simd arrays" and then
-// refuses to vectorise.)
+// refuses to vectorise.) Wide = true only names a second instantiation, compiled with 512-bit
+// vectors (integrators/kernels/<model>_wide.cpp; the same arithmetic per cell, so bitwise the
+// same results): the explicit integrator picks it per sweep (-explicit_vector_width).
 // The 3-D box stencils (19pt, 27pt: 9 rows) take the weight-class path
 // explicit_row_box_classes when ExplicitRow::wclass is set (the fused driver sets it; a
 // different summation order, stated there); the 27-tap loop serves a 9-row stencil without
@@ -62,7 +64,7 @@ struct ExplicitRow {
 //   q(x) = (w_c A + w_f B) + w_e C   (the taps at dx = 0)
 //   p(x) = (w_f A + w_e B) + w_k C   (the taps at dx = -1, +1; w_k C left out if !Corners)
 // (each sum of products a chain of std::fma from the left)
-template <bool Corners>
+template <bool Corners, bool Wide = false>
 inline void box_row_profiles(const double* const* rows, const double* w, int x0, int len,
                              double* __restrict__ p, double* __restrict__ q) {
   const double* __restrict__ c0 = rows[0] + x0;
@@ -106,7 +108,7 @@ inline bool any_floor(const double* floor, int ns) {
   return false;
 }
 
-template <class M, bool FieldParams, bool Corners, bool Clamp>
+template <class M, bool FieldParams, bool Corners, bool Clamp, bool Wide = false>
 inline void explicit_row_box_classes(const ExplicitRow& a) {
   constexpr int NS = M::nspecies;
   constexpr int NP = M::nparams;
@@ -133,7 +135,7 @@ inline void explicit_row_box_classes(const ExplicitRow& a) {
   for (int i0 = 0; i0 < n; i0 += kBoxChunk) {
     const int m = n - i0 < kBoxChunk ? n - i0 : kBoxChunk;
     for (int s = 0; s < NS; ++s)
-      box_row_profiles<Corners>(a.src + s * 9, wc[s], i0 - 1, m + 2, pbuf[s], qbuf[s]);
+      box_row_profiles<Corners, Wide>(a.src + s * 9, wc[s], i0 - 1, m + 2, pbuf[s], qbuf[s]);
 #pragma GCC ivdep
     for (int x = 0; x < m; ++x) {
       const int i = i0 + x;
@@ -156,7 +158,7 @@ inline void explicit_row_box_classes(const ExplicitRow& a) {
   }
 }
 
-template <class M, int NR, bool Box, bool FieldParams, bool Clamp>
+template <class M, int NR, bool Box, bool FieldParams, bool Clamp, bool Wide = false>
 inline void explicit_row_taps(const ExplicitRow& a) {
   constexpr int NS = M::nspecies;
   constexpr int NP = M::nparams;
@@ -217,27 +219,27 @@ inline void explicit_row_taps(const ExplicitRow& a) {
   }
 }
 
-template <class M, int NR, bool Box, bool FieldParams>
+template <class M, int NR, bool Box, bool FieldParams, bool Wide = false>
 inline void explicit_row(const ExplicitRow& a) {
   const bool clamp = any_floor(a.floor, M::nspecies);
   if constexpr (NR == 9 && Box) {
     if (a.wclass) {
       const bool corners = a.wclass[3] != 0.0;
       if (clamp && corners)
-        explicit_row_box_classes<M, FieldParams, true, true>(a);
+        explicit_row_box_classes<M, FieldParams, true, true, Wide>(a);
       else if (clamp)
-        explicit_row_box_classes<M, FieldParams, false, true>(a);
+        explicit_row_box_classes<M, FieldParams, false, true, Wide>(a);
       else if (corners)
-        explicit_row_box_classes<M, FieldParams, true, false>(a);
+        explicit_row_box_classes<M, FieldParams, true, false, Wide>(a);
       else
-        explicit_row_box_classes<M, FieldParams, false, false>(a);
+        explicit_row_box_classes<M, FieldParams, false, false, Wide>(a);
       return;
     }
   }
   if (clamp)
-    explicit_row_taps<M, NR, Box, FieldParams, true>(a);
+    explicit_row_taps<M, NR, Box, FieldParams, true, Wide>(a);
   else
-    explicit_row_taps<M, NR, Box, FieldParams, false>(a);
+    explicit_row_taps<M, NR, Box, FieldParams, false, Wide>(a);
 }
 
 // The general path's update of one row: the diffusion terms were computed into div[s] (a row

@@ -30,13 +30,14 @@ constexpr int kRowLayouts = 4;
 // kinetics (integrators/runtime_kernels.hpp).
 struct ModelKernels {
   bool fused = true;
-  ExplicitRowFn explicit_row[2][kRowLayouts] = {};         // [field_params][layout]
+  // [wide][field_params][layout]; wide: the same rows compiled with 512-bit vectors
+  ExplicitRowFn explicit_row[2][2][kRowLayouts] = {};
   std::function<void(const ExplicitRow&)> explicit_pre[2]; // [field_params]
   ReactionRowFn reaction_row[2];                           // [field_params]
 
   // The fused kernel of a row stencil; throws std::logic_error for a layout without one
   // (callers check the stencil first: there are no null entries to call).
-  ExplicitRowFn row_kernel(bool field_params, int nrows, bool box) const {
+  ExplicitRowFn row_kernel(bool field_params, int nrows, bool box, bool wide = false) const {
     const int idx = !box && nrows == 3   ? 0
                     : !box && nrows == 5 ? 1
                     : box && nrows == 3  ? 2
@@ -44,21 +45,28 @@ struct ModelKernels {
                                          : -1;
     if (idx < 0 || !fused)
       throw std::logic_error("no fused explicit kernel for this stencil layout");
-    return explicit_row[field_params ? 1 : 0][idx];
+    return explicit_row[wide ? 1 : 0][field_params ? 1 : 0][idx];
   }
 };
 
-// The explicit rows (integrators/kernels/<model>.cpp, no FMA contraction) and the reaction rows
+// The explicit rows (integrators/kernels/<model>.cpp, no FMA contraction; the Wide copies in
+// <model>_wide.cpp, compiled with 512-bit vectors) and the reaction rows
 // (integrators/kernels/<model>_reaction.cpp, contracted: see CMakeLists.txt) of model M.
+template <class M, bool Wide> void explicit_row_kernels(ModelKernels& k) {
+  ExplicitRowFn(&r)[2][kRowLayouts] = k.explicit_row[Wide ? 1 : 0];
+  r[0][0] = &explicit_row<M, 3, false, false, Wide>;
+  r[0][1] = &explicit_row<M, 5, false, false, Wide>;
+  r[0][2] = &explicit_row<M, 3, true, false, Wide>;
+  r[0][3] = &explicit_row<M, 9, true, false, Wide>;
+  r[1][0] = &explicit_row<M, 3, false, true, Wide>;
+  r[1][1] = &explicit_row<M, 5, false, true, Wide>;
+  r[1][2] = &explicit_row<M, 3, true, true, Wide>;
+  r[1][3] = &explicit_row<M, 9, true, true, Wide>;
+}
+
 template <class M> void explicit_kernels(ModelKernels& k) {
-  k.explicit_row[0][0] = &explicit_row<M, 3, false, false>;
-  k.explicit_row[0][1] = &explicit_row<M, 5, false, false>;
-  k.explicit_row[0][2] = &explicit_row<M, 3, true, false>;
-  k.explicit_row[0][3] = &explicit_row<M, 9, true, false>;
-  k.explicit_row[1][0] = &explicit_row<M, 3, false, true>;
-  k.explicit_row[1][1] = &explicit_row<M, 5, false, true>;
-  k.explicit_row[1][2] = &explicit_row<M, 3, true, true>;
-  k.explicit_row[1][3] = &explicit_row<M, 9, true, true>;
+  explicit_row_kernels<M, false>(k);
+  explicit_row_kernels<M, true>(k);
   k.explicit_pre[0] = &explicit_row_pre<M, false>;
   k.explicit_pre[1] = &explicit_row_pre<M, true>;
 }
@@ -76,26 +84,48 @@ template <class M> ModelKernels model_kernels() {
 }
 
 extern template void explicit_kernels<models::Turing>(ModelKernels&);
+extern template void explicit_row_kernels<models::Turing, false>(ModelKernels&);
+extern template void explicit_row_kernels<models::Turing, true>(ModelKernels&);
 extern template void reaction_kernels<models::Turing>(ModelKernels&);
 extern template void explicit_kernels<models::GrayScott>(ModelKernels&);
+extern template void explicit_row_kernels<models::GrayScott, false>(ModelKernels&);
+extern template void explicit_row_kernels<models::GrayScott, true>(ModelKernels&);
 extern template void reaction_kernels<models::GrayScott>(ModelKernels&);
 extern template void explicit_kernels<models::GrayScottSims>(ModelKernels&);
+extern template void explicit_row_kernels<models::GrayScottSims, false>(ModelKernels&);
+extern template void explicit_row_kernels<models::GrayScottSims, true>(ModelKernels&);
 extern template void reaction_kernels<models::GrayScottSims>(ModelKernels&);
 extern template void explicit_kernels<models::Brusselator>(ModelKernels&);
+extern template void explicit_row_kernels<models::Brusselator, false>(ModelKernels&);
+extern template void explicit_row_kernels<models::Brusselator, true>(ModelKernels&);
 extern template void reaction_kernels<models::Brusselator>(ModelKernels&);
 extern template void explicit_kernels<models::GiererMeinhardt>(ModelKernels&);
+extern template void explicit_row_kernels<models::GiererMeinhardt, false>(ModelKernels&);
+extern template void explicit_row_kernels<models::GiererMeinhardt, true>(ModelKernels&);
 extern template void reaction_kernels<models::GiererMeinhardt>(ModelKernels&);
 extern template void explicit_kernels<models::Meinhardt>(ModelKernels&);
+extern template void explicit_row_kernels<models::Meinhardt, false>(ModelKernels&);
+extern template void explicit_row_kernels<models::Meinhardt, true>(ModelKernels&);
 extern template void reaction_kernels<models::Meinhardt>(ModelKernels&);
 extern template void explicit_kernels<models::Schnakenberg>(ModelKernels&);
+extern template void explicit_row_kernels<models::Schnakenberg, false>(ModelKernels&);
+extern template void explicit_row_kernels<models::Schnakenberg, true>(ModelKernels&);
 extern template void reaction_kernels<models::Schnakenberg>(ModelKernels&);
 extern template void explicit_kernels<models::FitzHughNagumo>(ModelKernels&);
+extern template void explicit_row_kernels<models::FitzHughNagumo, false>(ModelKernels&);
+extern template void explicit_row_kernels<models::FitzHughNagumo, true>(ModelKernels&);
 extern template void reaction_kernels<models::FitzHughNagumo>(ModelKernels&);
 extern template void explicit_kernels<models::Barkley>(ModelKernels&);
+extern template void explicit_row_kernels<models::Barkley, false>(ModelKernels&);
+extern template void explicit_row_kernels<models::Barkley, true>(ModelKernels&);
 extern template void reaction_kernels<models::Barkley>(ModelKernels&);
 extern template void explicit_kernels<models::BarkleyTurbulent>(ModelKernels&);
+extern template void explicit_row_kernels<models::BarkleyTurbulent, false>(ModelKernels&);
+extern template void explicit_row_kernels<models::BarkleyTurbulent, true>(ModelKernels&);
 extern template void reaction_kernels<models::BarkleyTurbulent>(ModelKernels&);
 extern template void explicit_kernels<models::Oregonator>(ModelKernels&);
+extern template void explicit_row_kernels<models::Oregonator, false>(ModelKernels&);
+extern template void explicit_row_kernels<models::Oregonator, true>(ModelKernels&);
 extern template void reaction_kernels<models::Oregonator>(ModelKernels&);
 
 } // namespace morphogen
