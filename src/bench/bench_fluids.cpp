@@ -1,6 +1,7 @@
 #include "bench/bench_fluids.hpp"
 
 #include "app/simulation.hpp"
+#include "bench/bench_scoped_options.hpp"
 #include "bench/bench_timing.hpp"
 
 #include <algorithm>
@@ -34,6 +35,7 @@ double seconds_per_step(MPI_Comm comm, Options& opt, int n, int steps, bool flui
   if (advect) o.push_back({"-advect", "a,b"});
   for (auto& [k, v] : o)
     MG_PETSC(PetscOptionsSetValue(nullptr, k, v.c_str()));
+  apply_integrator_options();
   Simulation sim(comm, opt, "");
   sim.step(); // warm up (matrices, preconditioners)
   return best_seconds_per_step(comm, sim, steps, 2);

@@ -1,6 +1,7 @@
 #include "bench/bench_fused.hpp"
 
 #include "app/simulation.hpp"
+#include "bench/bench_scoped_options.hpp"
 #include "core/user_error.hpp"
 
 #include <algorithm>
@@ -82,6 +83,7 @@ void bench_fused(MPI_Comm comm, Options& opt, const FusedSettings& fs, double ro
     set_options(o, false);
     double base = 0;
     {
+      apply_integrator_options();
       Simulation sim(comm, opt, "");
       const double cells = static_cast<double>(sim.grid().global_cells());
       base = cells / seconds_per_step(comm, sim, 1, steps, 3);

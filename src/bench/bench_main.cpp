@@ -21,6 +21,7 @@
 #include "bench/bench_fused.hpp"
 #include "bench/bench_output.hpp"
 #include "bench/bench_scaling.hpp"
+#include "bench/bench_scoped_options.hpp"
 #include "bench/bench_timing.hpp"
 #include "core/user_error.hpp"
 #include "integrators/model_kernels.hpp"
@@ -86,6 +87,7 @@ Result bench_explicit(MPI_Comm comm, Options& opt, const std::string& n, int ste
       {"-init_b", "1 - 0.5*square(1.25,1.25,0.1)"}};
   for (auto& [k, v] : opts)
     MG_PETSC(PetscOptionsSetValue(nullptr, k, v));
+  apply_integrator_options();
   Simulation sim(comm, opt, "");
   for (int i = 0; i < 5; ++i)
     sim.step(); // warm up
@@ -137,6 +139,7 @@ SplitResult bench_split(MPI_Comm comm, Options& opt,
     MG_PETSC(PetscOptionsSetValue(nullptr, k, v));
   for (auto& [k, v] : pc)
     MG_PETSC(PetscOptionsSetValue(nullptr, k.c_str(), v.c_str()));
+  apply_integrator_options();
   Simulation sim(comm, opt, "");
   sim.step(); // assembles the matrices and sets up the preconditioners
   const PetscInt its0 = sim.diffusion_solver()->total_iterations();
@@ -223,6 +226,7 @@ OptionPairs brusselator_deck(int n, const std::string& integrator, const std::st
 // Seconds per step (best of 3 blocks of `steps`, after 2 warm-up steps).
 double seconds_per_step(MPI_Comm comm, Options& opt, const OptionPairs& o, int steps) {
   set_case(o);
+  apply_integrator_options();
   Simulation sim(comm, opt, "");
   sim.step();
   sim.step();
@@ -232,6 +236,7 @@ double seconds_per_step(MPI_Comm comm, Options& opt, const OptionPairs& o, int s
 // Seconds per step of passes of `steps` fused steps (best of 3, after 2 single warm-up steps).
 double seconds_per_fused_step(MPI_Comm comm, Options& opt, const OptionPairs& o, int steps) {
   set_case(o);
+  apply_integrator_options();
   Simulation sim(comm, opt, "");
   sim.step();
   sim.step();
@@ -355,6 +360,7 @@ struct DeckRun {
 
 DeckRun run_deck(MPI_Comm comm, Options& opt, const OptionPairs& o, PetscInt steps) {
   set_case(o);
+  apply_integrator_options();
   Simulation sim(comm, opt, "");
   MPI_Barrier(comm);
   const double t0 = MPI_Wtime();
@@ -445,7 +451,9 @@ void print_bench_help(MPI_Comm comm, const Options& opt) {
               "Sections, in order: setup/PNG/memory at -bench_output_n, fused steps, implicit vs "
               "explicit, explicit 2-D and 3-D, the general path, split preconditioners, strong "
               "scaling and the weak-scaling model (README, Performance). Any morphogen option "
-              "(e.g. -explicit_in_place yes) also applies to every timed run.\n"
+              "also applies to every timed run; those of one integrator (-explicit_in_place, "
+              "-explicit_vector_width, -explicit_fuse_tile; -ts_diffusion, "
+              "-ts_diffusion_solver) only to that integrator's runs.\n"
               "Options (-name <value>: meaning):\n",
               MORPHOGEN_VERSION);
   for (const auto& r : opt.records())
@@ -504,6 +512,7 @@ int run(MPI_Comm comm) {
     return 0;
   }
   opt.check_unused("bench_"); // a mistyped -bench_* option, before minutes of timings
+  hold_integrator_options();  // -explicit_*, -ts_diffusion*: only for runs of their integrator
   if (with_fluids || only_fluids)
     bench_fluids(comm, opt, static_cast<int>(fluids_n), static_cast<int>(fluids_steps));
   if (only_fluids) return 0;

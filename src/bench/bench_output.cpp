@@ -2,6 +2,7 @@
 
 #include "app/png_output.hpp"
 #include "app/simulation.hpp"
+#include "bench/bench_scoped_options.hpp"
 #include "fields/field_fill.hpp"
 
 #include <sys/resource.h>
@@ -66,6 +67,7 @@ void bench_output(MPI_Comm comm, Options& opt, int n) {
   {
     MPI_Barrier(comm);
     const double t0 = MPI_Wtime();
+    apply_integrator_options();
     Simulation sim(comm, opt, "");
     const double setup = MPI_Wtime() - t0;
     const double cells = static_cast<double>(sim.grid().global_cells());

@@ -62,3 +62,16 @@ def test_bad_option_fails_before_timing(tmp_path, case):
     for n in needles:
         assert n in lines[0], lines[0]
     assert not TIMING_LINE.search(p.stdout), p.stdout
+
+
+def test_integrator_options_go_to_their_runs(tmp_path):
+    """-explicit_vector_width and -ts_diffusion_solver (which morphogen refuses in runs of
+    another integrator) apply to the bench's explicit and TS runs only: the split runs in the
+    same section do not fail on them, and the TS run uses the solver given."""
+    p = bench(["-bench_only_implicit", "true", "-bench_output_n", "0", "-bench_brusselator_T", "2",
+               "-bench_steps_split", "1", "-explicit_vector_width", "256",
+               "-ts_diffusion_solver", "ksp"], tmp_path, timeout=300)
+    assert p.returncode == 0, p.stderr
+    assert re.search(r"^split_vs_explicit grid=1024x1024 .*diffusion_solver=ksp", p.stdout, re.M)
+    assert "TS diffusion solve: ksp (-ts_diffusion_solver ksp)" in p.stdout, p.stdout
+    assert re.search(r"^brusselator_deck T=2\. ts ", p.stdout, re.M), p.stdout
