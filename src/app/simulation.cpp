@@ -287,14 +287,10 @@ void Simulation::read_model(Options& opt, const std::string& base_dir) {
     }
   }
   read_pins(opt, base_dir);
-  RowStencil rows;
-  to_rows(stencil_, rows);
-  const ModelKernels& mk = model_->kernels;
-  const ExplicitIntegrator::RowFn fn =
-      mk.fused ? mk.row_kernel(params_.any_field(), rows.nrows, rows.box) : nullptr;
-  integrator_ = std::make_unique<ExplicitIntegrator>(
-      *grid_, *halo_, fn, ns, stencil_, D_, floor_, params_, any_dirichlet ? &dirichlet_ : nullptr);
-  if (!mk.fused || !all_constant_diffusion())
+  integrator_ = std::make_unique<ExplicitIntegrator>(*grid_, *halo_, fused_row_kernel(false), ns,
+                                                     stencil_, D_, floor_, params_,
+                                                     any_dirichlet ? &dirichlet_ : nullptr);
+  if (!model_->kernels.fused || !all_constant_diffusion())
     integrator_->use_operators(operators(),
                                model_->kernels.explicit_pre[params_.any_field() ? 1 : 0]);
   integrator_->update_ghosts(u_);
@@ -687,15 +683,20 @@ void Simulation::read_vector_width(Options& opt) {
       "explicit fast path: the row kernel compiled with 256- or 512-bit vectors (the same "
       "results); auto: each rank times both in its first passes and keeps the faster (512 "
       "only where the build's CPU has AVX-512)");
-  const ModelKernels& mk = model_->kernels;
-  RowStencil rows;
-  to_rows(stencil_, rows);
-  const ExplicitIntegrator::RowFn wide =
-      mk.fused ? mk.row_kernel(params_.any_field(), rows.nrows, rows.box, true) : nullptr;
   integrator_->set_vector_width(w == "256"   ? KernelChoice::Mode::Narrow
                                 : w == "512" ? KernelChoice::Mode::Wide
                                              : KernelChoice::Mode::Auto,
-                                wide);
+                                fused_row_kernel(true));
+}
+
+// The model's fused row kernel for this stencil and parameter form, 256- or 512-bit compile;
+// nullptr for a model without fused kernels (a runtime model: the general path).
+ExplicitIntegrator::RowFn Simulation::fused_row_kernel(bool wide) const {
+  const ModelKernels& mk = model_->kernels;
+  if (!mk.fused) return nullptr;
+  RowStencil rows;
+  to_rows(stencil_, rows);
+  return mk.row_kernel(params_.any_field(), rows.nrows, rows.box, wide);
 }
 
 std::string Simulation::explicit_vector_width() const {

@@ -117,6 +117,7 @@ public:
 private:
   void read_fuse(Options& opt);
   void read_vector_width(Options& opt);
+  ExplicitIntegrator::RowFn fused_row_kernel(bool wide) const;
   void read_split_fuse();
   std::string fuse_blocker(std::string why) const;
   static constexpr PetscInt kMaxFusedSplitSteps = 1 << 20; // a pass ends at any observation

@@ -21,7 +21,8 @@ struct HeldOption {
 std::vector<HeldOption>& held() {
   static std::vector<HeldOption> options = [] {
     std::vector<HeldOption> v;
-    for (const char* k : {"-explicit_in_place", "-explicit_vector_width", "-explicit_fuse_tile"})
+    for (const char* k : {"-explicit_in_place", "-explicit_vector_width", "-explicit_fuse_tile",
+                          "-explicit_fuse_steps"})
       v.push_back({k, "explicit", false, {}});
     for (const char* k : {"-ts_diffusion", "-ts_diffusion_solver"})
       v.push_back({k, "ts", false, {}});
@@ -49,7 +50,8 @@ void apply_integrator_options() {
   MG_PETSC(PetscOptionsGetString(nullptr, nullptr, "-integrator", buf, sizeof buf, &set));
   const std::string integrator = buf;
   for (const HeldOption& h : held()) {
-    if (h.set && integrator == h.integrator)
+    if (!h.set) continue; // the bench's own value, if any (e.g. the fused section's k)
+    if (integrator == h.integrator)
       MG_PETSC(PetscOptionsSetValue(nullptr, h.key, h.value.empty() ? nullptr : h.value.c_str()));
     else
       MG_PETSC(PetscOptionsClearValue(nullptr, h.key));

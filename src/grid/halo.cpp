@@ -107,14 +107,19 @@ void Halo::split_runs(const std::vector<PetscInt>& ghost, const std::vector<Pets
 }
 
 // The ghosts of split_runs that are in no block run, grouped by their offset source - ghost
-// and ordered by position: arithmetic progressions of at least kMinRun become strided runs.
+// and their ghosted column (ghost % gx: a ghost layer more than one cell wide is one run per
+// column), ordered by position: arithmetic progressions of at least kMinRun become strided
+// runs.
 void Halo::split_strided(std::vector<PetscInt> ghost, std::vector<PetscInt> source) {
   std::vector<size_t> order(ghost.size());
   for (size_t q = 0; q < order.size(); ++q)
     order[q] = q;
+  const PetscInt gx = grid_.ghosted().m[0];
   std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
     const PetscInt da = source[a] - ghost[a], db = source[b] - ghost[b];
-    return da != db ? da < db : ghost[a] < ghost[b];
+    if (da != db) return da < db;
+    const PetscInt ca = ghost[a] % gx, cb = ghost[b] % gx;
+    return ca != cb ? ca < cb : ghost[a] < ghost[b];
   });
   auto same_run = [&](size_t a, size_t b, PetscInt stride) { // b follows a in a run
     return source[b] - ghost[b] == source[a] - ghost[a] && ghost[b] - ghost[a] == stride;

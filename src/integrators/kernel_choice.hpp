@@ -22,7 +22,6 @@ public:
   static constexpr int kWarmup = 1, kTrials = 4, kMaxTrials = 1024;
   static constexpr double kMinSeconds = 1e-3;
 
-  KernelChoice() = default;
   KernelChoice(RowFn narrow, RowFn wide, Mode mode);
 
   // True while the passes are timed (Auto, until the choice is made).

@@ -65,13 +65,22 @@ def test_bad_option_fails_before_timing(tmp_path, case):
 
 
 def test_integrator_options_go_to_their_runs(tmp_path):
-    """-explicit_vector_width and -ts_diffusion_solver (which morphogen refuses in runs of
-    another integrator) apply to the bench's explicit and TS runs only: the split runs in the
-    same section do not fail on them, and the TS run uses the solver given."""
+    """-explicit_vector_width, -explicit_fuse_steps and -ts_diffusion_solver (which morphogen
+    refuses in runs of another integrator) apply to the bench's explicit and TS runs only: the
+    split runs in the same section do not fail on them, and the TS run uses the solver given."""
     p = bench(["-bench_only_implicit", "true", "-bench_output_n", "0", "-bench_brusselator_T", "2",
                "-bench_steps_split", "1", "-explicit_vector_width", "256",
-               "-ts_diffusion_solver", "ksp"], tmp_path, timeout=300)
+               "-explicit_fuse_steps", "2", "-ts_diffusion_solver", "ksp"], tmp_path, timeout=300)
     assert p.returncode == 0, p.stderr
     assert re.search(r"^split_vs_explicit grid=1024x1024 .*diffusion_solver=ksp", p.stdout, re.M)
     assert "TS diffusion solve: ksp (-ts_diffusion_solver ksp)" in p.stdout, p.stdout
     assert re.search(r"^brusselator_deck T=2\. ts ", p.stdout, re.M), p.stdout
+
+
+def test_fused_section_keeps_its_depths(tmp_path):
+    """A -explicit_fuse_steps given to the bench does not cap the fused section's own k."""
+    p = bench(["-bench_only_fused", "true", "-bench_output_n", "0", "-bench_fuse_n", "64",
+               "-bench_fuse_steps", "4", "-bench_fuse_steps_timed", "8",
+               "-explicit_fuse_steps", "2"], tmp_path, timeout=120)
+    assert p.returncode == 0, p.stderr
+    assert re.search(r"^explicit_fused grid=64x64 stencil=9pt k=4 ", p.stdout, re.M), p.stdout

@@ -54,12 +54,14 @@ def test_widths_give_the_same_bytes(tmp_path, case, ranks):
 
 
 def test_auto_times_both(tmp_path):
-    p = run([DECK, "-grid_n", "128,128", "-steps", "300", "-png_every", "0", "-summary", "false",
+    # 2100 steps: more than the 1 warm-up + 2 x 1024 passes after which auto chooses on any CPU.
+    p = run([DECK, "-grid_n", "128,128", "-steps", "2100", "-png_every", "0", "-summary", "false",
              "-output_dir", str(tmp_path / "o")], tmp_path)
     assert p.returncode == 0, p.stderr
     line = [ln for ln in p.stdout.splitlines() if ln.startswith("explicit kernel")]
-    if line:  # AVX-512: the least pass of each compile is reported
-        assert "least pass 256-bit" in line[0] and "still timing" not in line[0], line
+    if not line:
+        pytest.skip("the build's CPU has no AVX-512: one compile, nothing to time")
+    assert "least pass 256-bit" in line[0] and "still timing" not in line[0], line
 
 
 @pytest.mark.parametrize("args,message", [

@@ -127,6 +127,23 @@ TEST(Halo, Mixed2D) {
 TEST(Halo, Periodic3D) {
   EXPECT_TRUE(check(spec3(P, P, P)));
 }
+// Large enough for the one-rank halo's strided runs (Halo::split_strided: ghost columns of
+// at least kMinRun cells), with 1- and 2-cell ghost layers (fused steps use k-cell layers).
+TEST(Halo, PeriodicStridedColumns) {
+  GridSpec s = spec3(P, P, P);
+  s.n = {9, 10, 11};
+  s.L = {9, 10, 11};
+  EXPECT_TRUE(check(s));
+  s.stencil_width = 2;
+  EXPECT_TRUE(check(s));
+  GridSpec t = spec2(P, P);
+  t.n = {12, 40, 1};
+  t.L = {12, 40, 1};
+  for (int w : {1, 2, 3}) {
+    t.stencil_width = w;
+    EXPECT_TRUE(check(t)) << "ghost width " << w;
+  }
+}
 TEST(Halo, Mixed3D) {
   EXPECT_TRUE(check(spec3(N, D, P)));
   EXPECT_TRUE(check(spec3(D, D, D)));

@@ -5,7 +5,9 @@
 // 83 cells is swept whole and as every sub-row [i0, i0 + n) with i0 < 17 (so each cell is once
 // in a vector body and once in a loop remainder, for 256- and 512-bit vectors). A rank's rows
 // and a fused pass's tiles are such sub-rows, so this is what keeps explicit results
-// independent of the decomposition and of -explicit_fuse_steps bit for bit.
+// independent of the decomposition and of -explicit_fuse_steps bit for bit. Both compiles of
+// the table (256- and 512-bit vectors, -explicit_vector_width) are swept, every entry is set,
+// and the wide compile gives the narrow one's bits on every sub-row.
 #include "../model_typed_tests.hpp"
 #include <gtest/gtest.h>
 
@@ -15,6 +17,7 @@
 #include <tuple>
 #include <vector>
 
+#include "integrators/kernel_choice.hpp"
 #include "integrators/model_kernels.hpp"
 #include "models/all_models.hpp"
 
@@ -105,19 +108,28 @@ TYPED_TEST(ExplicitRowPosition, EveryCellTheSameBitsWhereverItLiesInTheRow) {
       for (size_t t = 0; t < w.size(); ++t)
         w[t] = 0.05 + 0.01 * static_cast<double>(t % 5);
       const double wclass[4] = {-2.0, 0.3, 0.05, 0.01};
-      const ExplicitRowFn fn = k.row_kernel(field, L.nr, L.box);
+      const double* wc = L.classes ? wclass : nullptr;
+      const ExplicitRowFn narrow = k.row_kernel(field, L.nr, L.box, false);
+      const ExplicitRowFn wide = k.row_kernel(field, L.nr, L.box, true);
+      ASSERT_NE(narrow, nullptr);
+      ASSERT_NE(wide, nullptr);
+      // Two compiles where the build has 512-bit vectors; the same code otherwise.
+      if (wide_vectors_available()) EXPECT_NE(narrow, wide);
       std::vector<std::vector<double>> whole(NS, std::vector<double>(kN));
-      sweep<M>(fn, rows, w.data(), L.classes ? wclass : nullptr, pdef, field, 0, kN, whole);
-      long differ = 0;
-      for (int i0 = 0; i0 < 17; ++i0)
-        for (int n = 1; i0 + n <= kN; n += 3) {
-          std::vector<std::vector<double>> part(NS, std::vector<double>(kN));
-          sweep<M>(fn, rows, w.data(), L.classes ? wclass : nullptr, pdef, field, i0, n, part);
-          for (int s = 0; s < NS; ++s)
-            for (int i = i0; i < i0 + n; ++i)
-              differ += std::memcmp(&part[s][i], &whole[s][i], sizeof(double)) != 0 ? 1 : 0;
-        }
+      sweep<M>(narrow, rows, w.data(), wc, pdef, field, 0, kN, whole);
+      long differ = 0, differ_wide = 0;
+      for (const ExplicitRowFn fn : {narrow, wide})
+        for (int i0 = 0; i0 < 17; ++i0)
+          for (int n = 1; i0 + n <= kN; n += (fn == wide ? 1 : 3)) {
+            std::vector<std::vector<double>> part(NS, std::vector<double>(kN));
+            sweep<M>(fn, rows, w.data(), wc, pdef, field, i0, n, part);
+            for (int s = 0; s < NS; ++s)
+              for (int i = i0; i < i0 + n; ++i)
+                (fn == wide ? differ_wide : differ) +=
+                    std::memcmp(&part[s][i], &whole[s][i], sizeof(double)) != 0 ? 1 : 0;
+          }
       EXPECT_EQ(differ, 0) << "cells whose bits depend on their place in the row";
+      EXPECT_EQ(differ_wide, 0) << "cells of the 512-bit compile that differ from the 256-bit one";
     }
 }
 
