@@ -125,8 +125,10 @@ void ExplicitIntegrator::use_terms(const TermList& terms) {
   constrain_after_sweep_ = false; // the fused kernels apply the clamp floor themselves
   for (const auto& c : terms.constraints())
     constrain_after_sweep_ = constrain_after_sweep_ || !dynamic_cast<const ClampFloor*>(c.get());
-  rates_.assign(others_.empty() ? 0 : static_cast<size_t>(ns_),
-                std::vector<double>(static_cast<size_t>(grid_.owned().size())));
+  rates_.clear(); // (no prototype row of a field's size where no other term needs one)
+  if (!others_.empty())
+    rates_.assign(static_cast<size_t>(ns_),
+                  std::vector<double>(static_cast<size_t>(grid_.owned().size())));
 }
 
 void ExplicitIntegrator::step(std::vector<VecH>& u, double t, double dt, PetscInt /*step*/) {

@@ -51,26 +51,16 @@ SliceImage full_resolution(const Grid& grid, const double* a, PetscInt k) {
   return img;
 }
 
-} // namespace
-
-SliceImage gather_xy_slice_image(const Grid& grid, const double* a, PetscInt k,
-                                 long long max_size) {
-  const long long nx = grid.spec().n[0], ny = grid.spec().n[1];
-  if (block_factor(nx, ny, max_size) == 1) return full_resolution(grid, a, k);
-  MPI_Comm comm = grid.comm();
+// Every rank's block sums of rect {bx0, by0, bw, bh}, gathered on rank 0 and added into the
+// image's p.w x p.h blocks (integer sums: the order does not matter); empty off rank 0. The
+// rank's own sums are released once sent and the gathered ones once added (a 4096^2 field's
+// 1024^2 image is 25 MB per copy: the run's peak memory if held together).
+std::vector<BlockSum> gather_block_sums(MPI_Comm comm, const BlockMeanPlan& p,
+                                        const std::array<long long, 4>& rect,
+                                        std::vector<BlockSum> sums) {
   int size = 1, rank = 0;
   MPI_Comm_size(comm, &size);
   MPI_Comm_rank(comm, &rank);
-  const Box& ob = grid.owned();
-  const bool mine = k >= ob.s[2] && k < ob.s[2] + ob.m[2];
-  const auto range = finite_range(grid, a, k, mine);
-  const BlockMeanPlan p = block_mean_plan(nx, ny, max_size, range[0], range[1]);
-  const auto rect = block_rect(grid, p, mine);
-  std::vector<BlockSum> sums(static_cast<size_t>(rect[2] * rect[3]));
-  if (mine)
-    for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j)
-      add_row_to_blocks(p, j, ob.s[0], ob.m[0], a + grid.local_index(ob.s[0], j, k), rect[0],
-                        rect[1], rect[2], sums.data());
   std::vector<long long> rects(rank == 0 ? 4 * static_cast<size_t>(size) : 0);
   MPI_Gather(rect.data(), 4, MPI_LONG_LONG, rects.data(), 4, MPI_LONG_LONG, 0, comm);
   std::vector<int> counts(size, 0), displs(size, 0);
@@ -85,15 +75,9 @@ SliceImage gather_xy_slice_image(const Grid& grid, const double* a, PetscInt k,
   static_assert(sizeof(BlockSum) == 3 * sizeof(std::int64_t));
   MPI_Gatherv(sums.data(), static_cast<int>(3 * sums.size()), MPI_INT64_T, all.data(),
               counts.data(), displs.data(), MPI_INT64_T, 0, comm);
-  SliceImage img;
-  img.factor = p.f;
-  img.width = static_cast<int>(p.w);
-  img.height = static_cast<int>(p.h);
-  img.lo = range[0];
-  img.hi = range[1];
-  if (rank != 0) return img;
-  std::vector<BlockSum> total(static_cast<size_t>(p.w * p.h));
-  for (int q = 0; q < size; ++q) { // integer sums: the order does not matter
+  std::vector<BlockSum>().swap(sums);
+  std::vector<BlockSum> total(rank == 0 ? static_cast<size_t>(p.w * p.h) : 0);
+  for (int q = 0; q < (rank == 0 ? size : 0); ++q) {
     const long long* r = &rects[4 * static_cast<size_t>(q)];
     const BlockSum* src = all.data() + displs[q] / 3;
     for (long long J = 0; J < r[3]; ++J)
@@ -105,7 +89,33 @@ SliceImage gather_xy_slice_image(const Grid& grid, const double* a, PetscInt k,
         t.bad += s.bad;
       }
   }
-  img.value.resize(total.size());
+  return total;
+}
+
+} // namespace
+
+SliceImage gather_xy_slice_image(const Grid& grid, const double* a, PetscInt k,
+                                 long long max_size) {
+  const long long nx = grid.spec().n[0], ny = grid.spec().n[1];
+  if (block_factor(nx, ny, max_size) == 1) return full_resolution(grid, a, k);
+  const Box& ob = grid.owned();
+  const bool mine = k >= ob.s[2] && k < ob.s[2] + ob.m[2];
+  const auto range = finite_range(grid, a, k, mine);
+  const BlockMeanPlan p = block_mean_plan(nx, ny, max_size, range[0], range[1]);
+  const auto rect = block_rect(grid, p, mine);
+  std::vector<BlockSum> sums(static_cast<size_t>(rect[2] * rect[3]));
+  if (mine)
+    for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j)
+      add_row_to_blocks(p, j, ob.s[0], ob.m[0], a + grid.local_index(ob.s[0], j, k), rect[0],
+                        rect[1], rect[2], sums.data());
+  const std::vector<BlockSum> total = gather_block_sums(grid.comm(), p, rect, std::move(sums));
+  SliceImage img;
+  img.factor = p.f;
+  img.width = static_cast<int>(p.w);
+  img.height = static_cast<int>(p.h);
+  img.lo = range[0];
+  img.hi = range[1];
+  img.value.resize(total.size()); // rank 0 only
   for (size_t b = 0; b < total.size(); ++b)
     img.value[b] = block_mean(p, total[b]);
   return img;
