@@ -56,10 +56,11 @@ const Conditional kConditional[] = {
      "(auto, default)"},
     {"explicit_",
      "-explicit_fuse_steps K, -explicit_fuse_tile N, -explicit_in_place auto|yes|no, "
-     "-explicit_vector_width auto|256|512",
+     "-explicit_vector_width auto|256|512, -explicit_prefetch auto|yes|no",
      "with -integrator explicit: K steps fused per pass (temporal blocking), owned columns per "
-     "tile of a fused pass, the in-place update, and the row kernel compiled with 256- or "
-     "512-bit vectors (auto: timed per rank); all give the same results"},
+     "tile of a fused pass, the in-place update, the row kernel compiled with 256- or "
+     "512-bit vectors (auto: timed per rank), and software prefetch of the rows read from "
+     "memory; all give the same results"},
     {"ts_diffusion", "-ts_diffusion implicit|explicit",
      "with -integrator ts: diffusion implicit (IMEX) or in the explicit right-hand side "
      "(default implicit)"},

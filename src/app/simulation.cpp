@@ -644,7 +644,8 @@ void Simulation::step() {
 void Simulation::read_fuse(Options& opt) {
   const char* key = "explicit_fuse_steps";
   if (split_ || ts_) {
-    for (const char* k : {key, "explicit_in_place", "explicit_fuse_tile", "explicit_vector_width"})
+    for (const char* k : {key, "explicit_in_place", "explicit_fuse_tile", "explicit_vector_width",
+                          "explicit_prefetch"})
       if (opt.is_set(k))
         throw UserError(std::string("-") + k + ": applies to -integrator explicit only");
     if (split_fuse_) read_split_fuse();
@@ -667,6 +668,13 @@ void Simulation::read_fuse(Options& opt) {
   integrator_->set_in_place(in_place == "yes"  ? ExplicitIntegrator::InPlace::Always
                             : in_place == "no" ? ExplicitIntegrator::InPlace::Never
                                                : ExplicitIntegrator::InPlace::Auto);
+  const std::string prefetch = opt.choice(
+      "explicit_prefetch", "auto", {"auto", "yes", "no"},
+      "fast path: software prefetch of the row read from memory 3 rows ahead (auto: where a "
+      "rank's state is at least 8 MiB); the same results");
+  integrator_->set_prefetch(prefetch == "yes"  ? ExplicitIntegrator::Prefetch::Always
+                            : prefetch == "no" ? ExplicitIntegrator::Prefetch::Never
+                                               : ExplicitIntegrator::Prefetch::Auto);
   read_vector_width(opt);
   const std::string why = fuse_blocker(integrator_->fuse_unsupported());
   fuse_ = why.empty() ? k : 1;

@@ -22,7 +22,7 @@ std::vector<HeldOption>& held() {
   static std::vector<HeldOption> options = [] {
     std::vector<HeldOption> v;
     for (const char* k : {"-explicit_in_place", "-explicit_vector_width", "-explicit_fuse_tile",
-                          "-explicit_fuse_steps"})
+                          "-explicit_fuse_steps", "-explicit_prefetch"})
       v.push_back({k, "explicit", false, {}});
     for (const char* k : {"-ts_diffusion", "-ts_diffusion_solver"})
       v.push_back({k, "ts", false, {}});

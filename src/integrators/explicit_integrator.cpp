@@ -1,6 +1,7 @@
 #include "integrators/explicit_integrator.hpp"
 
 #include "core/log_events.hpp"
+#include "core/prefetch.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -252,6 +253,16 @@ bool ExplicitIntegrator::in_place() const {
          bytes >= (grid_.dim() == 3 ? kInPlaceBytes3d : kInPlaceBytes);
 }
 
+bool ExplicitIntegrator::prefetch() const {
+  if (prefetch_ != Prefetch::Auto) return prefetch_ == Prefetch::Always;
+  return 8.0 * ns_ * static_cast<double>(grid_.owned().size()) >= kPrefetchBytes;
+}
+
+PetscInt ExplicitIntegrator::prefetch_offset(const std::vector<PetscInt>& delta) const {
+  if (!prefetch() || delta.empty()) return -1;
+  return *std::max_element(delta.begin(), delta.end()) + kPrefetchRows * grid_.ghosted().m[0];
+}
+
 // In-place sweeps (header comment): the old row t is last read by row t + R_z bh + R_y.
 int ExplicitIntegrator::reach(int axis) const {
   int r = 0;
@@ -358,7 +369,8 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
   // With scalar parameters into a second state set (no ring), one call sweeps all rows of a
   // block (the kernel steps the row pointers by the ghosted row length): small grids spend less
   // on per-call setup. Same arithmetic per cell either way.
-  const bool multi = !in_place && !field_mode && !by_class_;
+  const PetscInt pf_off = prefetch_offset(delta), pf_end = grid_.ghosted().size() - ob.m[0];
+  const bool multi = !in_place && !field_mode && !by_class_ && pf_off < 0;
   row.src_stride = row.dst_stride = gx;
   for (PetscInt jb = ob.s[1]; jb < jlast; jb += jblock) {
     const PetscInt jend = std::min(jb + jblock, jlast), bh = jend - jb, lag = rz * bh + ry;
@@ -381,6 +393,9 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
           for (int q = 0; q < np; ++q)
             prow[q] = pf[q] ? pf[q] + o : const_rows_[q].data();
         }
+        if (pf_off >= 0 && c + pf_off <= pf_end)
+          for (int s = 0; s < ns_; ++s)
+            prefetch_doubles(in[s] + c + pf_off, ob.m[0]);
         row_fn(row);
         if (in_place && t >= lag) commit_row(in, t - lag, jb, bh, to_edge);
       }

@@ -88,6 +88,18 @@ public:
   static constexpr double kInPlaceBytes3d = 64.0 * 1024 * 1024;
   void set_in_place(InPlace mode) { in_place_ = mode; }
 
+  // Software prefetch, in the single-step sweep, of the row read from memory kPrefetchRows rows
+  // after the stencil's leading row (core/prefetch.hpp): Auto where a rank's state is at least
+  // kPrefetchBytes (out of the per-core caches; in cache the prefetches only cost instructions);
+  // Always and Never force it. Nothing read changes, so neither do the results. (Fused passes
+  // do not prefetch: their rows take k times the arithmetic, which hides the loads already;
+  // prefetching there measured 1-5 % slower at 4096^2, k = 8.)
+  enum class Prefetch { Auto, Always, Never };
+  static constexpr double kPrefetchBytes = 8.0 * 1024 * 1024;
+  static constexpr int kPrefetchRows = 2;
+  void set_prefetch(Prefetch mode) { prefetch_ = mode; }
+  bool prefetch() const;
+
   // The fast path's second compile of the row kernel (512-bit vectors, the same results) and
   // how to choose between the two (-explicit_vector_width: timed in the first passes, or forced).
   void set_vector_width(KernelChoice::Mode mode, RowFn wide_fn) {
@@ -117,6 +129,9 @@ private:
   bool in_place() const;
   int reach(int axis) const;   // the stencil's reach in y (axis 0) or z (axis 1)
   PetscInt block_rows() const; // y rows per block of the sweep
+  // Offset from a row's first cell to the first cell of the row to prefetch (-1: none): the
+  // stencil's leading row (largest offset in `delta`) kPrefetchRows rows further in y.
+  PetscInt prefetch_offset(const std::vector<PetscInt>& delta) const;
   // Ring slot of row t of a block (order within the block: t = (k - k0) bh + j - jb).
   double* ring_row(int s, PetscInt t) const {
     return ring_.data() + (static_cast<size_t>(s) * ring_depth_ +
@@ -178,6 +193,7 @@ private:
   mutable SweepTables tab_;
   size_t ring_n_ = 0; // owned cells per row
   InPlace in_place_ = InPlace::Auto;
+  Prefetch prefetch_ = Prefetch::Auto;
   std::vector<std::vector<double>> rates_; // owned layout, per species (other terms)
   int fuse_request_ = 1;
   PetscInt fuse_tile_ = 0;
