@@ -452,7 +452,8 @@ void print_bench_help(MPI_Comm comm, const Options& opt) {
               "explicit, explicit 2-D and 3-D, the general path, split preconditioners, strong "
               "scaling and the weak-scaling model (README, Performance). Any morphogen option "
               "also applies to every timed run; those of one integrator (-explicit_in_place, "
-              "-explicit_vector_width, -explicit_fuse_tile, -explicit_fuse_steps; -ts_diffusion, "
+              "-explicit_vector_width, -explicit_fuse_tile, -explicit_fuse_steps, "
+              "-explicit_prefetch; -ts_diffusion, "
               "-ts_diffusion_solver) only to that integrator's runs.\n"
               "Options (-name <value>: meaning):\n",
               MORPHOGEN_VERSION);

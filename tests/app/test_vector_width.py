@@ -2,7 +2,8 @@
 integrators/kernel_choice.hpp: 256-bit and 512-bit vectors, auto times both in the first passes
 of each rank) give the same bytes, on 1, 2 and 4 ranks: 5- and 9-point stencils in 2-D, 7-, 19-
 and 27-point in 3-D, per-cell and scalar parameters, a clamp floor, Dirichlet faces, the in-place
-sweep and fused passes (-explicit_fuse_steps). The log names the compile that ran."""
+sweep and fused passes (-explicit_fuse_steps). The log names the compile that ran. Software
+prefetch (-explicit_prefetch) on and off give the same bytes too."""
 import os
 
 import pytest
