@@ -670,8 +670,9 @@ void Simulation::read_fuse(Options& opt) {
                                                : ExplicitIntegrator::InPlace::Auto);
   const std::string prefetch = opt.choice(
       "explicit_prefetch", "auto", {"auto", "yes", "no"},
-      "fast path: software prefetch of the row read from memory 3 rows ahead (auto: where a "
-      "rank's state is at least 8 MiB); the same results");
+      "explicit fast path, single steps: software prefetch of the row read from memory two rows "
+      "after the stencil's leading row (auto: where a rank's state is at least 8 MiB); the same "
+      "results");
   integrator_->set_prefetch(prefetch == "yes"  ? ExplicitIntegrator::Prefetch::Always
                             : prefetch == "no" ? ExplicitIntegrator::Prefetch::Never
                                                : ExplicitIntegrator::Prefetch::Auto);
