@@ -30,6 +30,8 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <functional>
+#include <memory>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -223,32 +225,14 @@ OptionPairs brusselator_deck(int n, const std::string& integrator, const std::st
   return o;
 }
 
-// Seconds per step (best of 3 blocks of `steps`, after 2 warm-up steps).
-double seconds_per_step(MPI_Comm comm, Options& opt, const OptionPairs& o, int steps) {
+// The run of the case `o` (its options set, then read by Simulation), after 2 warm-up steps.
+std::unique_ptr<Simulation> warm_run(MPI_Comm comm, Options& opt, const OptionPairs& o) {
   set_case(o);
   apply_integrator_options();
-  Simulation sim(comm, opt, "");
-  sim.step();
-  sim.step();
-  return best_seconds_per_step(comm, sim, steps, 3);
-}
-
-// Seconds per step of passes of `steps` fused steps (best of 3, after 2 single warm-up steps).
-double seconds_per_fused_step(MPI_Comm comm, Options& opt, const OptionPairs& o, int steps) {
-  set_case(o);
-  apply_integrator_options();
-  Simulation sim(comm, opt, "");
-  sim.step();
-  sim.step();
-  double best = 1e30;
-  for (int rep = 0; rep < 3; ++rep) {
-    MPI_Barrier(comm);
-    const double t0 = MPI_Wtime();
-    sim.advance(std::min<PetscInt>(steps, sim.fuse_steps()));
-    MPI_Barrier(comm);
-    best = std::min(best, (MPI_Wtime() - t0) / steps);
-  }
-  return best;
+  auto sim = std::make_unique<Simulation>(comm, opt, "");
+  sim->step();
+  sim->step();
+  return sim;
 }
 
 // The per-cell reaction substep alone: nanoseconds per cell of the Strang half-step (dt 0.05,
@@ -314,41 +298,53 @@ void bench_reaction_kernel(MPI_Comm comm) {
 }
 
 // A split step (auto: the exact transform solve where it applies, and KSP) against an explicit
-// step on the same grid and ranks, Brusselator deck settings at n^2.
+// step on the same grid and ranks, Brusselator deck settings at n^2. Each split case's blocks
+// (`steps` steps; the fused cases one pass of them) alternate with blocks of the explicit run
+// (20 times as many steps), best of 5 each: the ratio of two bests taken in the same minutes.
 void bench_split_vs_explicit(MPI_Comm comm, Options& opt, int n, int steps) {
-  const int ex_steps = std::max(10, steps * 20);
-  const double ex =
-      seconds_per_step(comm, opt, brusselator_deck(n, "explicit", "0.0025"), ex_steps);
-  for (const char* solver : {"auto", "ksp"}) {
-    const double sp =
-        seconds_per_step(comm, opt, brusselator_deck(n, "split", "0.1", solver), steps);
+  const int ex_steps = std::max(10, steps * 20), reps = 5;
+  const std::unique_ptr<Simulation> ex =
+      warm_run(comm, opt, brusselator_deck(n, "explicit", "0.0025"));
+  const TimedBlock ex_block{[&] { ex->step(); },
+                            [&] {
+                              for (int i = 0; i < ex_steps; ++i)
+                                ex->step();
+                            },
+                            ex_steps};
+  auto compare = [&](const OptionPairs& o, bool fused, const std::string& label) {
+    const std::unique_ptr<Simulation> sp = warm_run(comm, opt, o);
+    const int k = fused ? static_cast<int>(std::min<PetscInt>(steps, sp->fuse_steps())) : steps;
+    const TimedBlock block{[&] { sp->step(); },
+                           [&] {
+                             if (fused)
+                               sp->advance(k);
+                             else
+                               for (int i = 0; i < k; ++i)
+                                 sp->step();
+                           },
+                           k};
+    const auto [e, t] = interleaved_best(comm, ex_block, block, reps);
     PetscPrintf(comm,
-                "split_vs_explicit grid=%dx%d model=brusselator diffusion_solver=%s "
-                "split_step_ms=%.3f explicit_step_ms=%.4f ratio=%.1f target_ratio<=10 %s\n",
-                n, n, solver, 1e3 * sp, 1e3 * ex, sp / ex, sp / ex <= 10.0 ? "met" : "NOT met");
-  }
-  const double rk =
-      seconds_per_step(comm, opt, brusselator_deck(n, "split", "0.1", "auto", "rk4"), steps);
-  PetscPrintf(comm,
-              "split_vs_explicit grid=%dx%d model=brusselator diffusion_solver=auto "
-              "split_reaction=rk4 split_step_ms=%.3f explicit_step_ms=%.4f ratio=%.1f "
-              "target_ratio<=10 %s\n",
-              n, n, 1e3 * rk, 1e3 * ex, rk / ex, rk / ex <= 10.0 ? "met" : "NOT met");
+                "split_vs_explicit grid=%dx%d model=brusselator %s%s split_step_ms=%.3f "
+                "explicit_step_ms=%.4f ratio=%.1f target_ratio<=10 %s\n",
+                n, n, label.c_str(), fused ? (" fused_passes=" + std::to_string(k)).c_str() : "",
+                1e3 * t, 1e3 * e, t / e, t / e <= 10.0 ? "met" : "NOT met");
+  };
+  for (const char* solver : {"auto", "ksp"})
+    compare(brusselator_deck(n, "split", "0.1", solver), false,
+            std::string("diffusion_solver=") + solver);
+  compare(brusselator_deck(n, "split", "0.1", "auto", "rk4"), false,
+          "diffusion_solver=auto split_reaction=rk4");
   // The fused cases; the last again with the full transform along the slowest axis (fft) beside
   // the default (auto: tridiagonal along it where it applies).
   for (const char* reaction : {"trapezoidal", "rk4", "rk4 fft"}) {
     const std::string r(reaction), scheme = r.substr(0, r.find(' '));
-    const char* slow = r.find("fft") != std::string::npos ? "fft" : "auto";
+    const std::string slow = r.find("fft") != std::string::npos ? "fft" : "auto";
     OptionPairs fused = brusselator_deck(n, "split", "0.1", "auto", scheme);
     fused.push_back({"-split_fuse_reaction", "true"});
     fused.push_back({"-diffusion_slow_axis", slow});
-    const double fu = seconds_per_fused_step(comm, opt, fused, steps);
-    PetscPrintf(comm,
-                "split_vs_explicit grid=%dx%d model=brusselator diffusion_solver=auto "
-                "diffusion_slow_axis=%s split_reaction=%s fused_passes=%d split_step_ms=%.3f "
-                "explicit_step_ms=%.4f ratio=%.1f target_ratio<=10 %s\n",
-                n, n, slow, scheme.c_str(), steps, 1e3 * fu, 1e3 * ex, fu / ex,
-                fu / ex <= 10.0 ? "met" : "NOT met");
+    compare(fused, true,
+            "diffusion_solver=auto diffusion_slow_axis=" + slow + " split_reaction=" + scheme);
   }
 }
 

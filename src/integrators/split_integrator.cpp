@@ -19,7 +19,6 @@ SplitIntegrator::SplitIntegrator(const Grid& grid, ReactionRowFn fn,
       sources_(sources), diffusion_(diffusion), set_(settings) {
   const size_t row = static_cast<size_t>(grid.owned().m[0]);
   if (params_.any_field()) params_.expand_scalars(row, const_rows_);
-  row_out_.assign(species.size(), std::vector<double>(row));
   substeps_ = split_substeps(set_.ordering);
   global_ = grid.create_global();
 }
@@ -50,8 +49,6 @@ void SplitIntegrator::react(std::vector<VecH>& u, double t0, double dt, PetscInt
   const Box& ob = grid_.owned();
   std::vector<const double*> in(ns), prow(np), s0(ns), s1(ns);
   std::vector<double*> out(ns);
-  for (int s = 0; s < ns; ++s)
-    out[s] = row_out_[s].data();
   std::string err;
   int worst_its = 0;
   for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2] && err.empty(); ++k)
@@ -60,6 +57,7 @@ void SplitIntegrator::react(std::vector<VecH>& u, double t0, double dt, PetscInt
       const PetscInt o = grid_.owned_index(ob.s[0], j, k);
       for (int s = 0; s < ns; ++s) {
         in[s] = a[s] + c;
+        out[s] = a[s] + c; // in place (reaction rows read a cell before writing it)
         s0[s] = S0[s] ? S0[s] + o : zeros.data();
         s1[s] = S1[s] ? S1[s] + o : zeros.data();
       }
@@ -83,8 +81,6 @@ void SplitIntegrator::react(std::vector<VecH>& u, double t0, double dt, PetscInt
         break;
       }
       worst_its = std::max(worst_its, worst.iterations);
-      for (int s = 0; s < ns; ++s)
-        std::copy(out[s], out[s] + ob.m[0], a[s] + c);
     }
   for (int q = 0; q < np; ++q)
     if (pf[q]) MG_PETSC(VecRestoreArrayRead(params_.field[q], &pf[q]));

@@ -96,7 +96,7 @@ private:
   DiffusionSolver& diffusion_;
   SplitSettings set_;
   std::vector<Substep> substeps_;
-  std::vector<std::vector<double>> const_rows_, row_out_;
+  std::vector<std::vector<double>> const_rows_;
   VecH global_;
   int last_its_ = 0;
 };

@@ -114,7 +114,9 @@ TYPED_TEST(ExplicitRowPosition, EveryCellTheSameBitsWhereverItLiesInTheRow) {
       ASSERT_NE(narrow, nullptr);
       ASSERT_NE(wide, nullptr);
       // Two compiles where the build has 512-bit vectors; the same code otherwise.
-      if (wide_vectors_available()) EXPECT_NE(narrow, wide);
+      if (wide_vectors_available()) {
+        EXPECT_NE(narrow, wide);
+      }
       std::vector<std::vector<double>> whole(NS, std::vector<double>(kN));
       sweep<M>(narrow, rows, w.data(), wc, pdef, field, 0, kN, whole);
       long differ = 0, differ_wide = 0;
