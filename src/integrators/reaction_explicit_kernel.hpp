@@ -5,9 +5,11 @@
 //   Rk4    the classical Runge-Kutta step, sources S0, (S0 + S1)/2, (S0 + S1)/2, S1
 // The same arithmetic as reaction_cell_of's explicit schemes (detail::explicit_cell), computed
 // for W = 16 cells at once in one branch-free loop over the lanes (reaction_lanes.hpp), which GCC
-// vectorises; the per-cell path calls the whole Newton-capable cell solver per cell (about 20
-// ns against 2-5 ns here). Values agree with it to an ulp (the compiler may contract a
-// multiply-add differently in vector code) and do not depend on a cell's place in the row.
+// vectorises (the whole row function with 512-bit vectors where the target has them,
+// MG_LANES_WIDE: the lane loop inlines into it and takes its vector width); the per-cell path calls
+// the whole Newton-capable cell solver per cell (about 20 ns against 2-5 ns here). Values agree
+// with it to an ulp (the compiler may contract a multiply-add differently in vector code) and do
+// not depend on a cell's place in the row.
 //
 // reaction_row_explicit has reaction_row's contract: outputs clamped to floor, out may alias u,
 // returns -1, or the first cell whose new value is not finite (the cells before it written, it
@@ -49,9 +51,10 @@ MG_LANES_WIDE inline void explicit_lanes(LockstepLanes<M::nspecies, NP, W>& L, d
 }
 
 template <class M, bool FieldParams, ReactionScheme S>
-inline int explicit_row(int n, const double* const* u, const double* const* prow,
-                        const double* pconst, const double* const* S0, const double* const* S1,
-                        double dt, const double* floor, double* const* out) {
+MG_LANES_WIDE inline int explicit_row(int n, const double* const* u, const double* const* prow,
+                                      const double* pconst, const double* const* S0,
+                                      const double* const* S1, double dt, const double* floor,
+                                      double* const* out) {
   constexpr int NS = M::nspecies, NP = M::nparams > 0 ? M::nparams : 1, W = 16;
   LockstepLanes<NS, NP, W> L;
   for (int i0 = 0; i0 < n; i0 += W) {
