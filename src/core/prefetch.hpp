@@ -9,6 +9,11 @@
 
 namespace morphogen {
 
+// Sweeps prefetch where a rank's state is at least this large (out of the per-core caches; in
+// cache the prefetches only cost instructions), this many rows ahead.
+constexpr double kPrefetchMinBytes = 8.0 * 1024 * 1024;
+constexpr int kPrefetchRowsAhead = 2;
+
 inline void prefetch_doubles(const double* p, std::ptrdiff_t n) {
   const char* c = reinterpret_cast<const char*>(p);
   const std::ptrdiff_t bytes = n * static_cast<std::ptrdiff_t>(sizeof(double));

@@ -32,6 +32,8 @@
 // fuse_steps() is 1); parameters must not change between steps (the caller's check).
 #pragma once
 
+#include "core/prefetch.hpp"
+
 #include "fields/param_set.hpp"
 #include "grid/halo.hpp"
 #include "grid/stencil.hpp"
@@ -95,8 +97,8 @@ public:
   // do not prefetch: their rows take k times the arithmetic, which hides the loads already;
   // prefetching there measured 1-5 % slower at 4096^2, k = 8.)
   enum class Prefetch { Auto, Always, Never };
-  static constexpr double kPrefetchBytes = 8.0 * 1024 * 1024;
-  static constexpr int kPrefetchRows = 2;
+  static constexpr double kPrefetchBytes = kPrefetchMinBytes;
+  static constexpr int kPrefetchRows = kPrefetchRowsAhead;
   void set_prefetch(Prefetch mode) { prefetch_ = mode; }
   bool prefetch() const;
 

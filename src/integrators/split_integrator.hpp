@@ -8,14 +8,16 @@
 // (reaction_kernel.hpp: explicit Euler or Heun, or implicit backward Euler or trapezoidal by
 // Newton with the model's analytic Jacobian, as in the stable-ARD paper's Appendix A but for
 // every model); a cell that fails to converge stops the run with its global index, values and
-// residual. D(dt) is the implicit diffusion substep (diffusion_solver.hpp: backward Euler or
-// Crank-Nicolson, theta = 1 or 1/2). Second order needs Strang with Crank-Nicolson and a
-// second-order reaction scheme (Heun or trapezoidal). The clamp floor is applied after the
-// reaction substeps and at the end of the step. Diffusion coefficients and Dirichlet values
-// using t are set at the diffusion substep's midpoint t + dt/2 (TermList::set_time; the matrices
-// of the species whose coefficients changed are re-assembled, constant-in-time runs untouched).
-// Fused Strang (steps(), when nothing observes the state between the n steps of a pass): the
-// reaction half-steps of consecutive steps merge into one,
+// residual. The reaction pass runs in place, row by row, prefetching the rows two ahead where a
+// rank's state does not fit the per-core caches (core/prefetch.hpp). D(dt) is the implicit
+// diffusion substep (diffusion_solver.hpp: backward Euler or Crank-Nicolson, theta = 1 or 1/2).
+// Second order needs Strang with Crank-Nicolson and a second-order reaction scheme (Heun or
+// trapezoidal). The clamp floor is applied after the reaction substeps and at the end of the step.
+// Diffusion coefficients and Dirichlet values using t are set at the diffusion substep's midpoint t
+// + dt/2 (TermList::set_time; the matrices of the species whose coefficients changed are
+// re-assembled, constant-in-time runs untouched). Fused Strang (steps(), when nothing observes the
+// state between the n steps of a pass): the reaction half-steps of consecutive steps merge into
+// one,
 //   R(dt/2) D(dt) [R(dt) D(dt)]^(n-1) R(dt/2),
 // the same order (second) with n - 1 fewer reaction substeps; a pass of 1 step is step().
 #pragma once
@@ -99,6 +101,7 @@ private:
   std::vector<std::vector<double>> const_rows_;
   VecH global_;
   int last_its_ = 0;
+  bool prefetch_ = false; // the reaction pass prefetches rows (the rank's state >= 8 MiB)
 };
 
 } // namespace morphogen
