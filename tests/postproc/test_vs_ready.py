@@ -112,7 +112,8 @@ def test_errors_are_one_line(tmp_path):
     r = run_script("--rdy", failing, "--cases", "2d:16", "--updates", "2560", "--repeat", "1")
     assert r.returncode == 2 and r.stderr.strip().count("\n") == 0
     assert "rdy (" in r.stderr and "code 3" in r.stderr and "OpenCL build failed" in r.stderr
-    # morphogen's own error line, not mpiexec's banner after it
-    r = run_script("--rdy", fake_rdy(tmp_path), "--cases", "2d:16", "--updates", "2560",
+    # morphogen's own error line, not mpiexec's banner after it (the stand-in is timed first:
+    # 100 and 1100 steps, 0.5 s apart, so that a loaded machine cannot make them look equal)
+    r = run_script("--rdy", fake_rdy(tmp_path), "--cases", "2d:16", "--updates", "256000",
                    "--repeat", "1", "--morphogen", str(tmp_path / "no_such_morphogen"))
     assert r.returncode == 2 and "morphogen (" in r.stderr, r.stderr
