@@ -13,10 +13,10 @@
 // diffusion substep (diffusion_solver.hpp: backward Euler or Crank-Nicolson, theta = 1 or 1/2).
 // Second order needs Strang with Crank-Nicolson and a second-order reaction scheme (Heun or
 // trapezoidal). The clamp floor is applied after the reaction substeps and at the end of the step.
-// Diffusion coefficients and Dirichlet values using t are set at the diffusion substep's midpoint t
-// + dt/2 (TermList::set_time; the matrices of the species whose coefficients changed are
-// re-assembled, constant-in-time runs untouched). Fused Strang (steps(), when nothing observes the
-// state between the n steps of a pass): the reaction half-steps of consecutive steps merge into
+// Diffusion coefficients and Dirichlet values using t are set at the diffusion substep's
+// midpoint, t + dt/2 (TermList::set_time; the matrices of the species whose coefficients changed
+// are re-assembled, constant-in-time runs untouched). Fused Strang (steps(), when nothing observes
+// the state between the n steps of a pass): the reaction half-steps of consecutive steps merge into
 // one,
 //   R(dt/2) D(dt) [R(dt) D(dt)]^(n-1) R(dt/2),
 // the same order (second) with n - 1 fewer reaction substeps; a pass of 1 step is step().
