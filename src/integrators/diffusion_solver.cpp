@@ -204,15 +204,27 @@ void DiffusionSolver::prepare(double dt, double theta) {
 }
 
 bool DiffusionSolver::solve_local(int s, Vec ulocal, double dt, double theta) {
+  if (!solve_local_begin(s, ulocal, dt, theta)) return false;
+  solve_local_end(s, ulocal);
+  return true;
+}
+
+bool DiffusionSolver::solve_local_begin(int s, Vec ulocal, double dt, double theta) {
   if (ops_.scale(s) == 0.0) { // no diffusion: nothing to do (as in solve)
     iterations_[s] = 0;
     return true;
   }
   if (ops_.has_dirichlet() || !use_spectral(s) || !spectral_[s]->steps_local()) return false;
   LogScope log_scope(log_events().diffusion);
-  spectral_[s]->step_local(ulocal, dt * ops_.scale(s), theta);
+  spectral_[s]->step_local_begin(ulocal, dt * ops_.scale(s), theta);
   iterations_[s] = 0;
   return true;
+}
+
+void DiffusionSolver::solve_local_end(int s, Vec ulocal) {
+  if (ops_.scale(s) == 0.0) return;
+  LogScope log_scope(log_events().diffusion);
+  spectral_[s]->step_local_end(ulocal);
 }
 
 void DiffusionSolver::solve(int s, Vec u, double dt, double theta, PetscInt step) {

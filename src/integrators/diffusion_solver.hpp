@@ -64,6 +64,11 @@ public:
   // on it in place (no Dirichlet data); false (nothing done) elsewhere: then copy to a global
   // vector and call solve.
   bool solve_local(int s, Vec ulocal, double dt, double theta);
+  // solve_local in two halves (ExactSolve::step_local_begin/end: one species' wait for the other
+  // ranks overlaps the next species' solve). begin returns false (nothing done) where
+  // solve_local would; after a true begin, call end before ulocal is used.
+  bool solve_local_begin(int s, Vec ulocal, double dt, double theta);
+  void solve_local_end(int s, Vec ulocal);
 
   // Species s's matrix was re-assembled (solution-dependent coefficients, lagged per step):
   // A_s is rebuilt on the next solve.

@@ -102,9 +102,21 @@ void SplitIntegrator::diffuse(std::vector<VecH>& u, double dt, PetscInt step) {
   // In place where the exact solve reads and writes the ghosted local state itself; otherwise
   // owned cells move between it and the solver's global vector row by row (the solve needs no
   // ghosts; DMLocalToGlobal does not support every periodic layout).
+  // Local solves run in two halves: each species' wait for the other ranks comes after the
+  // next species' solve has started (finished before any other solve and at the end).
   const Box& ob = grid_.owned();
+  std::vector<size_t> pending;
+  auto finish = [&] {
+    for (size_t p : pending)
+      diffusion_.solve_local_end(static_cast<int>(p), u[p]);
+    pending.clear();
+  };
   for (size_t s = 0; s < u.size(); ++s) {
-    if (diffusion_.solve_local(static_cast<int>(s), u[s], dt, set_.theta)) continue;
+    if (diffusion_.solve_local_begin(static_cast<int>(s), u[s], dt, set_.theta)) {
+      pending.push_back(s);
+      continue;
+    }
+    finish();
     for (int dir = 0; dir < 2; ++dir) {
       PetscScalar *l, *g;
       MG_PETSC(VecGetArray(u[s], &l));
@@ -123,6 +135,7 @@ void SplitIntegrator::diffuse(std::vector<VecH>& u, double dt, PetscInt step) {
       if (dir == 0) diffusion_.solve(static_cast<int>(s), global_, dt, set_.theta, step);
     }
   }
+  finish();
 }
 
 std::vector<Substep> split_substeps(SplitOrdering ordering) {

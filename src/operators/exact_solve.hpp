@@ -24,6 +24,13 @@ public:
   virtual void step_local(Vec /*ulocal*/, double /*c*/, double /*theta*/) {
     throw std::logic_error("ExactSolve::step_local: not offered by " + method());
   }
+  // step_local in two halves, so that one species' wait for the other ranks overlaps the next
+  // species' work: begin does what needs no other rank's result yet, end the rest; ulocal is not
+  // to be touched between them. Default: all of it in begin.
+  virtual void step_local_begin(Vec ulocal, double c, double theta) {
+    step_local(ulocal, c, theta);
+  }
+  virtual void step_local_end(Vec /*ulocal*/) {}
   // For the setup log, e.g. "spectral (FFT/DCT, exact)".
   virtual std::string method() const = 0;
 };

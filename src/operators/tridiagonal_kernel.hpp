@@ -29,10 +29,11 @@ inline void tri_forward_row(int n, const double* a, const double* inv, const dou
     cur[l] = (cur[l] - a[l] * prev[l]) * inv[l];
 }
 
-// Back substitution step: cur -= gp next.
-inline void tri_backward_row(int n, const double* gp, const double* next, double* cur) {
+// Back substitution step: out = cur - gp next (out may alias cur).
+inline void tri_backward_row(int n, const double* gp, const double* next, const double* cur,
+                             double* out) {
   for (int l = 0; l < n; ++l)
-    cur[l] -= gp[l] * next[l];
+    out[l] = cur[l] - gp[l] * next[l];
 }
 
 // cur *= s.

@@ -1,11 +1,13 @@
 #include "operators/tridiagonal_solver.hpp"
 
 #include "core/petsc_handle.hpp"
+#include "core/prefetch.hpp"
 #include "operators/spectral_solver.hpp"
 #include "operators/tridiagonal_kernel.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 
 // LAPACK (Fortran): solve A X = B by LU with partial pivoting.
@@ -26,6 +28,14 @@ TridiagonalSolver::TridiagonalSolver(const Grid& grid, std::unique_ptr<SpectralT
   n_ = static_cast<int>(t_->columns()) * w_;
   lo_.assign(static_cast<size_t>(n_), 0.0);
   hi_ = lo_;
+  xs_.assign(2 * scratch_stride() + 8, 0.0);
+}
+
+// Scratch row k (0 or 1) of up(), 64-byte aligned (FFTW's inverse plans then read it directly).
+double* TridiagonalSolver::scratch(int k) {
+  const auto addr = reinterpret_cast<std::uintptr_t>(xs_.data());
+  double* base = xs_.data() + (64 - addr % 64) % 64 / sizeof(double);
+  return base + static_cast<size_t>(k) * scratch_stride();
 }
 
 TridiagonalSolver::~TridiagonalSolver() = default;
@@ -152,16 +162,26 @@ bool TridiagonalSolver::check_product(Mat M, std::string* why) {
   return true;
 }
 
-// lo_ = plane a0 - 1, hi_ = plane a0 + m (wrapped when periodic; zero off the axis).
-void TridiagonalSolver::exchange_edges() {
+// lo_ = plane a0 - 1, hi_ = plane a0 + m (wrapped when periodic; zero off the axis): posted by
+// begin_edges (rows 0 and m - 1 are sent from and must not change until end_edges).
+void TridiagonalSolver::begin_edges() {
   const int left = rank_ > 0 ? rank_ - 1 : periodic_ ? size_ - 1 : MPI_PROC_NULL;
   const int right = rank_ < size_ - 1 ? rank_ + 1 : periodic_ ? 0 : MPI_PROC_NULL;
   std::fill(lo_.begin(), lo_.end(), 0.0);
   std::fill(hi_.begin(), hi_.end(), 0.0);
-  MPI_Sendrecv(row(m_ - 1), n_, MPI_DOUBLE, right, 0, lo_.data(), n_, MPI_DOUBLE, left, 0, comm_,
-               MPI_STATUS_IGNORE);
-  MPI_Sendrecv(row(0), n_, MPI_DOUBLE, left, 1, hi_.data(), n_, MPI_DOUBLE, right, 1, comm_,
-               MPI_STATUS_IGNORE);
+  MPI_Irecv(lo_.data(), n_, MPI_DOUBLE, left, 0, comm_, &edge_req_[0]);
+  MPI_Irecv(hi_.data(), n_, MPI_DOUBLE, right, 1, comm_, &edge_req_[1]);
+  MPI_Isend(row(m_ - 1), n_, MPI_DOUBLE, right, 0, comm_, &edge_req_[2]);
+  MPI_Isend(row(0), n_, MPI_DOUBLE, left, 1, comm_, &edge_req_[3]);
+}
+
+void TridiagonalSolver::end_edges() {
+  MPI_Waitall(4, edge_req_, MPI_STATUSES_IGNORE);
+}
+
+void TridiagonalSolver::exchange_edges() {
+  begin_edges();
+  end_edges();
 }
 
 const double* TridiagonalSolver::diagonal(PetscInt j) const {
@@ -358,6 +378,7 @@ void TridiagonalSolver::apply(Vec r, Vec x, double s0, double s1) {
     v = t_->reals(x, false);
   }
   up(v);
+  ends_begin();
   ends(v);
   t_->reals_done(x, v, true);
 }
@@ -370,20 +391,30 @@ void TridiagonalSolver::down(const PlaneView& in, double s0, double s1) {
   const bool product = s1 != 0.0;
   s0 /= t_->norm();
   s1 /= t_->norm();
+  const size_t n = static_cast<size_t>(n_);
   if (product) {
     t_->plane_forward(in, 0, row(0));
     t_->plane_forward(in, m_ - 1, row(m_ - 1));
-    exchange_edges();
-    prev_ = lo_;
-    cur_.resize(static_cast<size_t>(n_));
+    begin_edges(); // received while the planes between are transformed (lo_ used last, hi_ at m -
+                   // 1)
+    prev_.resize(n);
+    cur_.resize(n);
+    raw1_.resize(n);
   }
   for (PetscInt j = 0; j < m_; ++j) {
     double* y = row(j);
     if (product) {
+      if (j + 3 < m_ - 1)
+        for (PetscInt r = 0; r < in.rows; ++r)
+          prefetch_doubles(in.base + (j + 3) * in.plane + r * in.row, in.len);
       if (j + 1 < m_ - 1) t_->plane_forward(in, j + 1, row(j + 1));
+      if (j == m_ - 1) end_edges();
       std::copy(y, y + n_, cur_.begin());
-      tri_multiply_row(n_, s0, s1, a_.data(), diagonal(j), g_.data(), prev_.data(), cur_.data(),
-                       j + 1 < m_ ? row(j + 1) : hi_.data(), y);
+      if (j == 0) // row 0's product waits for lo_ (below); row 1 as it is now
+        std::copy(row(1), row(1) + n_, raw1_.begin());
+      else
+        tri_multiply_row(n_, s0, s1, a_.data(), diagonal(j), g_.data(), prev_.data(), cur_.data(),
+                         j + 1 < m_ ? row(j + 1) : hi_.data(), y);
       std::swap(prev_, cur_);
     } else {
       t_->plane_forward(in, j, y);
@@ -392,21 +423,31 @@ void TridiagonalSolver::down(const PlaneView& in, double s0, double s1) {
     if (j >= 1 && j <= ni)
       tri_forward_row(n_, ia_.data(), inv_row(j - 1), j > 1 ? row(j - 1) : nullptr, y);
   }
+  if (product) // row 0 is no interior row: the elimination above did not use it
+    tri_multiply_row(n_, s0, s1, a_.data(), diagonal(0), g_.data(), lo_.data(), row(0),
+                     raw1_.data(), row(0));
 }
 
 // Back substitution of the interior; an interior row the spikes do not reach is final and goes
-// back to the reals once the row above has used it.
+// back to the reals once the row above has used it. Such rows are formed in two scratch rows
+// (alternating), not in the spectrum: its rows are then only read here, so that their cache
+// lines are not written back to memory (the spiked rows stay in the spectrum for ends()).
 void TridiagonalSolver::up(const PlaneView& out) {
   const PetscInt ni = m_ - 2;
+  if (ni < 1) return;
+  const double* next = row(ni);
   for (PetscInt i = ni - 2; i >= 0; --i) {
-    tri_backward_row(n_, gp_row(i), row(i + 2), row(i + 1));
-    if (!spiked(i + 1)) emit(i + 2, out);
+    if (i >= 2) prefetch_doubles(row(i - 1), n_);
+    double* x = spiked(i) ? row(i + 1) : scratch(static_cast<int>(i & 1));
+    tri_backward_row(n_, gp_row(i), next, row(i + 1), x);
+    if (!spiked(i + 1)) t_->plane_backward(const_cast<double*>(next), out, i + 2);
+    next = x;
   }
 }
 
-// The block's ends F, E from the reduced system (right-hand sides allgathered), the spiked
-// interior rows corrected, and all of them back to the reals.
-void TridiagonalSolver::ends(const PlaneView& out) {
+// The reduced system's right-hand sides of this block (first and last interior rows after up),
+// allgathered without waiting (ends() waits).
+void TridiagonalSolver::ends_begin() {
   const size_t n = static_cast<size_t>(n_);
   const PetscInt ni = m_ - 2;
   gmine_.resize(2 * n);
@@ -415,9 +456,18 @@ void TridiagonalSolver::ends(const PlaneView& out) {
     gmine_[l] = ni > 0 ? f0[l] - ig_[l] * f1[l] : f0[l];
     gmine_[n + l] = ni > 0 ? fe[l] - ia_[l] * fe1[l] : fe[l];
   }
+  gall_.resize(static_cast<size_t>(2 * size_) * n);
+  MPI_Iallgather(gmine_.data(), 2 * n_, MPI_DOUBLE, gall_.data(), 2 * n_, MPI_DOUBLE, comm_,
+                 &gather_req_);
+}
+
+// The block's ends F, E from the reduced system (after ends_begin), the spiked interior rows
+// corrected, and all of them back to the reals.
+void TridiagonalSolver::ends(const PlaneView& out) {
+  const size_t n = static_cast<size_t>(n_);
+  const PetscInt ni = m_ - 2;
   const int K = 2 * size_;
-  gall_.resize(static_cast<size_t>(K) * n);
-  MPI_Allgather(gmine_.data(), 2 * n_, MPI_DOUBLE, gall_.data(), 2 * n_, MPI_DOUBLE, comm_);
+  MPI_Wait(&gather_req_, MPI_STATUS_IGNORE);
   F_.assign(n, 0.0);
   E_.assign(n, 0.0);
   for (int k = 0; k < K; ++k)
@@ -443,23 +493,32 @@ void TridiagonalSolver::step(Vec u, double c, double theta) {
 
 // The owned planes of a ghosted local vector are layout A when the DMDA is split in slabs.
 void TridiagonalSolver::step_local(Vec ulocal, double c, double theta) {
+  step_local_begin(ulocal, c, theta);
+  step_local_end(ulocal);
+}
+
+// Transform, elimination and back substitution; the reduced system's allgather posted.
+void TridiagonalSolver::step_local_begin(Vec ulocal, double c, double theta) {
   if (!t_->direct()) throw std::logic_error("TridiagonalSolver::step_local: not slabs");
   factor(c, theta);
   const Box& gb = grid_.ghosted();
   const bool three = grid_.dim() == 3;
-  PlaneView v;
-  MG_PETSC(VecGetArray(ulocal, &v.base));
-  double* const a = v.base;
-  v.base += three ? grid_.local_index(0, 0, a0_) : grid_.local_index(0, a0_, 0);
-  v.row = gb.m[0];
-  v.plane = three ? gb.m[0] * gb.m[1] : gb.m[0];
-  v.rows = three ? grid_.spec().n[1] : 1;
-  v.len = grid_.spec().n[0];
-  down(v, 1.0, explicit_part(c, theta));
-  up(v);
-  ends(v);
-  double* b = a;
-  MG_PETSC(VecRestoreArray(ulocal, &b));
+  MG_PETSC(VecGetArray(ulocal, &local_array_));
+  local_.base =
+      local_array_ + (three ? grid_.local_index(0, 0, a0_) : grid_.local_index(0, a0_, 0));
+  local_.row = gb.m[0];
+  local_.plane = three ? gb.m[0] * gb.m[1] : gb.m[0];
+  local_.rows = three ? grid_.spec().n[1] : 1;
+  local_.len = grid_.spec().n[0];
+  down(local_, 1.0, explicit_part(c, theta));
+  up(local_);
+  ends_begin();
+}
+
+void TridiagonalSolver::step_local_end(Vec ulocal) {
+  ends(local_);
+  MG_PETSC(VecRestoreArray(ulocal, &local_array_));
+  local_array_ = nullptr;
 }
 
 void TridiagonalSolver::solve_shifted(Vec r, Vec x, double c, double theta) {

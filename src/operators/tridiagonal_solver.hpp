@@ -25,9 +25,13 @@
 // (transform, product and forward elimination going down; back substitution going up, the rows
 // the spikes do not reach transformed back at once; the reduced system and the rest), with
 // each plane in cache between its steps; the spikes decay geometrically and are kept only
-// where they exceed 2^-64 (truncate_spikes). create() returns null and says why where it
-// does not apply (at most kMaxRanks ranks, S >= 3 planes); the caller then uses the full
-// transform (spectral_solver.hpp) or KSP.
+// where they exceed 2^-64 (truncate_spikes). Waits are late: the edge planes travel while the
+// down pass runs (the first row's product is formed last), and step_local_begin / _end let the
+// reduced system's allgather of one species overlap the next species' passes (SplitIntegrator).
+// Back substitution writes the rows it emits at once to scratch rows (the spectrum's cache
+// lines stay clean), and the down pass prefetches the state's planes three ahead. create()
+// returns null and says why where it does not apply (at most kMaxRanks ranks, S >= 3 planes);
+// the caller then uses the full transform (spectral_solver.hpp) or KSP.
 #pragma once
 
 #include "grid/spectral_transform.hpp"
@@ -53,6 +57,8 @@ public:
   void solve_shifted(Vec r, Vec x, double c, double theta) override;
   bool steps_local() const override { return t_->direct(); }
   void step_local(Vec ulocal, double c, double theta) override;
+  void step_local_begin(Vec ulocal, double c, double theta) override;
+  void step_local_end(Vec ulocal) override;
   std::string method() const override;
 
 private:
@@ -61,6 +67,8 @@ private:
   bool measure(Mat M, std::string* why);
   bool dominant(std::string* why) const;
   bool check_product(Mat M, std::string* why);
+  void begin_edges();
+  void end_edges();
   void exchange_edges();
   void multiply(double s0, double s1); // spectrum <- s0 y + s1 M y
   void factor(double c, double theta);
@@ -79,6 +87,7 @@ private:
   void apply(Vec r, Vec x, double s0, double s1);
   void down(const PlaneView& in, double s0, double s1);
   void up(const PlaneView& out);
+  void ends_begin(); // the reduced system's right-hand sides, their allgather posted
   void ends(const PlaneView& out);
   bool spiked(PetscInt i) const { return i < kp_ || i >= m_ - 2 - kq_; } // interior row i
   void emit(PetscInt j, const PlaneView& out) { t_->plane_backward(row(j), out, j); }
@@ -104,6 +113,12 @@ private:
   std::vector<double> p_, q_;
   PetscInt kp_ = 0, kq_ = 0;
   std::vector<double> prev_, cur_, zero_, F_, E_; // one row each
+  std::vector<double> xs_;                        // up()'s two scratch rows
+  std::vector<double> raw1_; // down(): plane 1 before its product (row 0's product needs it)
+  MPI_Request edge_req_[4] = {MPI_REQUEST_NULL, MPI_REQUEST_NULL, MPI_REQUEST_NULL,
+                              MPI_REQUEST_NULL};
+  size_t scratch_stride() const { return (static_cast<size_t>(n_) + 7) / 8 * 8; }
+  double* scratch(int k);
   const double* inv_row(PetscInt i) const {
     return inv_.data() + static_cast<size_t>(std::min(i, nfac_ - 1)) * static_cast<size_t>(n_);
   }
@@ -112,6 +127,9 @@ private:
   }
   std::vector<double> rinv_; // [2][2P][lane]: my rows of the reduced inverse
   std::vector<double> gmine_, gall_;
+  MPI_Request gather_req_ = MPI_REQUEST_NULL;
+  PlaneView local_;               // step_local_begin's view of the local vector
+  double* local_array_ = nullptr; // and its array (restored by step_local_end)
 };
 
 } // namespace morphogen
