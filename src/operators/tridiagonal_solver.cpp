@@ -395,8 +395,7 @@ void TridiagonalSolver::down(const PlaneView& in, double s0, double s1) {
   if (product) {
     t_->plane_forward(in, 0, row(0));
     t_->plane_forward(in, m_ - 1, row(m_ - 1));
-    begin_edges(); // received while the planes between are transformed (lo_ used last, hi_ at m -
-                   // 1)
+    begin_edges(); // arrive while the planes between are transformed (hi_ used at m - 1, lo_ last)
     prev_.resize(n);
     cur_.resize(n);
     raw1_.resize(n);
