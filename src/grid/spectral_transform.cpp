@@ -16,7 +16,9 @@ namespace morphogen {
 struct SpectralTransform::Plans {
   fftw_plan restF = nullptr, restB = nullptr, slowF = nullptr, slowB = nullptr;
   fftw_plan planeF = nullptr, planeB = nullptr; // one plane of T_rest (rest_only)
-  std::unique_ptr<TrigTransform> trig;          // instead, for a row of cosines or sines (2-D)
+  // Instead, where no rest axis is periodic: rows of cosines or sines along x (and, in 3-D,
+  // the plane's columns along y, all at once).
+  std::unique_ptr<TrigTransform> trig, trig_cols;
   ~Plans() {
     for (fftw_plan p : {restF, restB, slowF, slowB, planeF, planeB})
       if (p) fftw_destroy_plan(p);
@@ -214,8 +216,12 @@ void SpectralTransform::plan(const Grid& grid, const std::array<AxisKind, 3>& ki
     auto* cS = reinterpret_cast<fftw_complex*>(planeS_);
     p.planeF = fftw_plan_dft_r2c(nrest, rest, planeR_, cS, flags);
     p.planeB = fftw_plan_dft_c2r(nrest, rest, cS, planeR_, flags);
-  } else if (rest_only_ && nrest == 1) {
-    p.trig = std::make_unique<TrigTransform>(rest[0], kinds[0] == AxisKind::Odd, flags);
+  } else if (rest_only_ && (nrest == 1 || kinds[1] != AxisKind::Periodic) &&
+             kinds[0] != AxisKind::Periodic) {
+    p.trig = std::make_unique<TrigTransform>(rest[nrest - 1], kinds[0] == AxisKind::Odd, flags);
+    if (nrest == 2)
+      p.trig_cols =
+          std::make_unique<TrigTransform>(rest[0], kinds[1] == AxisKind::Odd, flags, rest[1]);
   } else if (rest_only_) {
     p.planeF = fftw_plan_r2r(nrest, rest, planeR_, planeS_, kf + 1, flags);
     p.planeB = fftw_plan_r2r(nrest, rest, planeS_, planeR_, kb + 1, flags);
@@ -338,11 +344,17 @@ void SpectralTransform::reals_done(Vec u, const PlaneView& v, bool store) {
 // plane goes through the scratch plane. The inverse always writes the scratch plane, then copies
 // it out: a c2r transform also uses its output as work space, which is cheaper in a plane that
 // stays in L1 than in the state (2-D, 1024^2, 2 ranks: the diffusion substep 1-3 % faster than
-// writing aligned rows in place; the same bits either way). A row of cosines or sines (2-D,
-// x not periodic) is transformed by TrigTransform, in place in both directions.
+// writing aligned rows in place; the same bits either way). Planes of cosines and sines (no rest
+// axis periodic) are transformed by TrigTransform, rows from and to the state, then the
+// plane's columns (3-D) in the spectrum.
 void SpectralTransform::plane_forward(const PlaneView& v, PetscInt j, double* spec) {
   const double* p = v.base + j * v.plane;
-  if (plans_->trig) return plans_->trig->forward(p, spec);
+  if (plans_->trig) {
+    for (PetscInt r = 0; r < v.rows; ++r)
+      plans_->trig->forward(p + r * v.row, spec + r * v.len);
+    if (plans_->trig_cols) plans_->trig_cols->forward(spec, spec);
+    return;
+  }
   double* in = const_cast<double*>(p); // forward out-of-place plans preserve their input
   if (!((v.rows == 1 || v.row == v.len) && fftw_alignment_of(in) == 0)) {
     for (PetscInt r = 0; r < v.rows; ++r)
@@ -360,7 +372,12 @@ void SpectralTransform::plane_forward(const PlaneView& v, PetscInt j, double* sp
 void SpectralTransform::plane_backward(double* spec, const PlaneView& v, PetscInt j) {
   const PetscInt ns = ncolsS_ * w_;
   double* p = v.base + j * v.plane;
-  if (plans_->trig) return plans_->trig->backward(spec, p);
+  if (plans_->trig) {
+    if (plans_->trig_cols) plans_->trig_cols->backward(spec, spec);
+    for (PetscInt r = 0; r < v.rows; ++r)
+      plans_->trig->backward(spec + r * v.len, p + r * v.row);
+    return;
+  }
   double* in = fftw_alignment_of(spec) == 0 ? spec : std::copy(spec, spec + ns, planeS_) - ns;
   if (w_ == 2)
     fftw_execute_dft_c2r(plans_->planeB, reinterpret_cast<fftw_complex*>(in), planeR_);

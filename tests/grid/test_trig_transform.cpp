@@ -1,7 +1,7 @@
 // TrigTransform (cosine and sine rows through one real FFT) against FFTW's own r2r transforms of
 // the same kinds (REDFT10/01, RODFT10/01): the same values to 1e-14 of the row's largest, for
 // even and odd lengths from 1 to 1024, from unaligned input and into unaligned output; and
-// backward(forward(x)) = 2n x.
+// backward(forward(x)) = 2n x; interleaved columns (howmany > 1) as separate rows.
 #include "grid/trig_transform.hpp"
 
 #include <gtest/gtest.h>
@@ -87,4 +87,36 @@ TEST(TrigTransform, SingleModeIsOneCoefficient) {
   t.forward(x.data(), y.data());
   for (int q = 0; q < n; ++q)
     EXPECT_NEAR(y[q], q == k ? static_cast<double>(n) : 0.0, 1e-12) << "coefficient " << q;
+}
+
+// Several interleaved sequences (a plane's columns: entry j of column i at j * howmany + i),
+// in place: each column as its own row transform (an odd count: real FFTs; an even one: the
+// columns paired as complex sequences).
+TEST(TrigTransform, InterleavedColumnsAreRowTransforms) {
+  for (int hm : {5, 6, 2})
+    for (bool odd : {false, true})
+      for (int n : {1, 2, 7, 16, 33}) {
+        std::mt19937_64 gen(static_cast<unsigned>(7 * n + odd));
+        std::uniform_real_distribution<double> u(-1.0, 1.0);
+        std::vector<double> plane(static_cast<size_t>(n * hm));
+        for (double& v : plane)
+          v = u(gen);
+        const std::vector<double> start(plane);
+        TrigTransform cols(n, odd, FFTW_ESTIMATE, hm), row(n, odd, FFTW_ESTIMATE);
+        cols.forward(plane.data(), plane.data());
+        for (int i = 0; i < hm; ++i) {
+          std::vector<double> x(static_cast<size_t>(n)), y(static_cast<size_t>(n));
+          for (int j = 0; j < n; ++j)
+            x[j] = start[static_cast<size_t>(j * hm + i)];
+          row.forward(x.data(), y.data());
+          for (int j = 0; j < n; ++j)
+            EXPECT_NEAR(plane[static_cast<size_t>(j * hm + i)], y[j], 1e-13)
+                << "n = " << n << ", howmany = " << hm << ", odd = " << odd << ", column " << i
+                << ", entry " << j;
+        }
+        cols.backward(plane.data(), plane.data());
+        for (size_t q = 0; q < plane.size(); ++q)
+          EXPECT_NEAR(plane[q], 2.0 * n * start[q], 1e-12 * n)
+              << "round trip, n = " << n << ", howmany = " << hm;
+      }
 }
