@@ -19,6 +19,7 @@ struct SpectralTransform::Plans {
   // Instead, where no rest axis is periodic: rows of cosines or sines along x (and, in 3-D,
   // the plane's columns along y, all at once).
   std::unique_ptr<TrigTransform> trig, trig_cols;
+  std::unique_ptr<TrigTransform> trig_slow; // the columns of layout B, not periodic
   ~Plans() {
     for (fftw_plan p : {restF, restB, slowF, slowB, planeF, planeB})
       if (p) fftw_destroy_plan(p);
@@ -200,13 +201,21 @@ void SpectralTransform::plan(const Grid& grid, const std::array<AxisKind, 3>& ki
             ncS = static_cast<int>(ncolsS_);
   const unsigned flags = fft_planner_flags();
   Plans& p = *plans_;
+  const bool trig_rest =
+      w_ == 1 && kinds[0] != AxisKind::Periodic && (nrest == 1 || kinds[1] != AxisKind::Periodic);
+  if (trig_rest) {
+    p.trig = std::make_unique<TrigTransform>(rest[nrest - 1], kinds[0] == AxisKind::Odd, flags);
+    if (nrest == 2)
+      p.trig_cols =
+          std::make_unique<TrigTransform>(rest[0], kinds[1] == AxisKind::Odd, flags, rest[1]);
+  }
   if (howA > 0 && w_ == 2) {
     auto* cA = reinterpret_cast<fftw_complex*>(specA_);
     p.restF = fftw_plan_many_dft_r2c(nrest, rest, howA, realA_, nullptr, 1, nc, cA, nullptr, 1, ncS,
                                      flags);
     p.restB = fftw_plan_many_dft_c2r(nrest, rest, howA, cA, nullptr, 1, ncS, realA_, nullptr, 1, nc,
                                      flags);
-  } else if (howA > 0) {
+  } else if (howA > 0 && !trig_rest) {
     p.restF = fftw_plan_many_r2r(nrest, rest, howA, realA_, nullptr, 1, nc, specA_, nullptr, 1, nc,
                                  kf + 1, flags);
     p.restB = fftw_plan_many_r2r(nrest, rest, howA, specA_, nullptr, 1, nc, realA_, nullptr, 1, nc,
@@ -216,13 +225,7 @@ void SpectralTransform::plan(const Grid& grid, const std::array<AxisKind, 3>& ki
     auto* cS = reinterpret_cast<fftw_complex*>(planeS_);
     p.planeF = fftw_plan_dft_r2c(nrest, rest, planeR_, cS, flags);
     p.planeB = fftw_plan_dft_c2r(nrest, rest, cS, planeR_, flags);
-  } else if (rest_only_ && (nrest == 1 || kinds[1] != AxisKind::Periodic) &&
-             kinds[0] != AxisKind::Periodic) {
-    p.trig = std::make_unique<TrigTransform>(rest[nrest - 1], kinds[0] == AxisKind::Odd, flags);
-    if (nrest == 2)
-      p.trig_cols =
-          std::make_unique<TrigTransform>(rest[0], kinds[1] == AxisKind::Odd, flags, rest[1]);
-  } else if (rest_only_) {
+  } else if (rest_only_ && !trig_rest) {
     p.planeF = fftw_plan_r2r(nrest, rest, planeR_, planeS_, kf + 1, flags);
     p.planeB = fftw_plan_r2r(nrest, rest, planeS_, planeR_, kb + 1, flags);
   }
@@ -233,6 +236,8 @@ void SpectralTransform::plan(const Grid& grid, const std::array<AxisKind, 3>& ki
         fftw_plan_many_dft(1, &S, nb, cB, nullptr, nb, 1, cB, nullptr, nb, 1, FFTW_FORWARD, flags);
     p.slowB =
         fftw_plan_many_dft(1, &S, nb, cB, nullptr, nb, 1, cB, nullptr, nb, 1, FFTW_BACKWARD, flags);
+  } else if (nb > 0 && kinds[dim - 1] != AxisKind::Periodic) {
+    p.trig_slow = std::make_unique<TrigTransform>(S, kinds[dim - 1] == AxisKind::Odd, flags, nb);
   } else if (nb > 0) {
     p.slowF =
         fftw_plan_many_r2r(1, &S, nb, specB_, nullptr, nb, 1, specB_, nullptr, nb, 1, kf, flags);
@@ -262,7 +267,8 @@ void SpectralTransform::make_scatter(const Grid& grid) {
 }
 
 // T_rest from the DMDA vector u into specA (directly from u's array when layout A is u's part
-// and FFTW's alignment of the two arrays agrees, else through realA).
+// and FFTW's alignment of the two arrays agrees or the planes are TrigTransform's, else
+// through realA).
 void SpectralTransform::rest_forward(Vec u) {
   const PetscScalar* a = nullptr;
   double* in = realA_;
@@ -271,12 +277,15 @@ void SpectralTransform::rest_forward(Vec u) {
     MG_PETSC(VecScatterEnd(toA_, u, vA_, INSERT_VALUES, SCATTER_FORWARD));
   } else {
     MG_PETSC(VecGetArrayRead(u, &a));
-    if (fftw_alignment_of(const_cast<double*>(a)) == fftw_alignment_of(realA_))
+    if (fftw_alignment_of(const_cast<double*>(a)) == fftw_alignment_of(realA_) || plans_->trig)
       in = const_cast<double*>(a); // FFTW's forward out-of-place plans preserve their input
     else
       std::copy(a, a + (a1_ - a0_) * ncols_, realA_);
   }
-  if (plans_->restF && w_ == 2)
+  if (plans_->trig)
+    for (PetscInt s = 0; s < a1_ - a0_; ++s)
+      trig_plane_forward(in + s * ncols_, nx_, ncols_ / nx_, specA_ + s * ncols_);
+  else if (plans_->restF && w_ == 2)
     fftw_execute_dft_r2c(plans_->restF, in, reinterpret_cast<fftw_complex*>(specA_));
   else if (plans_->restF)
     fftw_execute_r2r(plans_->restF, in, specA_);
@@ -289,9 +298,12 @@ void SpectralTransform::rest_backward(Vec u) {
   double* out = realA_;
   if (direct_) {
     MG_PETSC(VecGetArray(u, &a));
-    if (fftw_alignment_of(a) == fftw_alignment_of(realA_)) out = a;
+    if (fftw_alignment_of(a) == fftw_alignment_of(realA_) || plans_->trig) out = a;
   }
-  if (plans_->restB && w_ == 2)
+  if (plans_->trig)
+    for (PetscInt s = 0; s < a1_ - a0_; ++s)
+      trig_plane_backward(specA_ + s * ncols_, out + s * ncols_, nx_, ncols_ / nx_);
+  else if (plans_->restB && w_ == 2)
     fftw_execute_dft_c2r(plans_->restB, reinterpret_cast<fftw_complex*>(specA_), out);
   else if (plans_->restB)
     fftw_execute_r2r(plans_->restB, specA_, out);
@@ -307,10 +319,12 @@ void SpectralTransform::rest_backward(Vec u) {
 void SpectralTransform::forward(Vec u) {
   rest_forward(u);
   if (size_ > 1 && !rest_only_) to_columns();
+  if (plans_->trig_slow) plans_->trig_slow->forward(specB_, specB_);
   run(plans_->slowF);
 }
 
 void SpectralTransform::backward(Vec u) {
+  if (plans_->trig_slow) plans_->trig_slow->backward(specB_, specB_);
   run(plans_->slowB);
   if (size_ > 1 && !rest_only_) from_columns();
   rest_backward(u);
@@ -349,12 +363,7 @@ void SpectralTransform::reals_done(Vec u, const PlaneView& v, bool store) {
 // plane's columns (3-D) in the spectrum.
 void SpectralTransform::plane_forward(const PlaneView& v, PetscInt j, double* spec) {
   const double* p = v.base + j * v.plane;
-  if (plans_->trig) {
-    for (PetscInt r = 0; r < v.rows; ++r)
-      plans_->trig->forward(p + r * v.row, spec + r * v.len);
-    if (plans_->trig_cols) plans_->trig_cols->forward(spec, spec);
-    return;
-  }
+  if (plans_->trig) return trig_plane_forward(p, v.row, v.rows, spec);
   double* in = const_cast<double*>(p); // forward out-of-place plans preserve their input
   if (!((v.rows == 1 || v.row == v.len) && fftw_alignment_of(in) == 0)) {
     for (PetscInt r = 0; r < v.rows; ++r)
@@ -372,12 +381,7 @@ void SpectralTransform::plane_forward(const PlaneView& v, PetscInt j, double* sp
 void SpectralTransform::plane_backward(double* spec, const PlaneView& v, PetscInt j) {
   const PetscInt ns = ncolsS_ * w_;
   double* p = v.base + j * v.plane;
-  if (plans_->trig) {
-    if (plans_->trig_cols) plans_->trig_cols->backward(spec, spec);
-    for (PetscInt r = 0; r < v.rows; ++r)
-      plans_->trig->backward(spec + r * v.len, p + r * v.row);
-    return;
-  }
+  if (plans_->trig) return trig_plane_backward(spec, p, v.row, v.rows);
   double* in = fftw_alignment_of(spec) == 0 ? spec : std::copy(spec, spec + ns, planeS_) - ns;
   if (w_ == 2)
     fftw_execute_dft_c2r(plans_->planeB, reinterpret_cast<fftw_complex*>(in), planeR_);
@@ -385,6 +389,22 @@ void SpectralTransform::plane_backward(double* spec, const PlaneView& v, PetscIn
     fftw_execute_r2r(plans_->planeB, in, planeR_);
   for (PetscInt r = 0; r < v.rows; ++r)
     std::copy(planeR_ + r * v.len, planeR_ + (r + 1) * v.len, p + r * v.row);
+}
+
+// A plane of cosines and sines: rows (`rows` of nx_ cells, `row` apart) to or from the plane's
+// spectrum (rows of nx_), whose columns are transformed in place (3-D).
+void SpectralTransform::trig_plane_forward(const double* p, std::ptrdiff_t row, PetscInt rows,
+                                           double* spec) {
+  for (PetscInt r = 0; r < rows; ++r)
+    plans_->trig->forward(p + r * row, spec + r * nx_);
+  if (plans_->trig_cols) plans_->trig_cols->forward(spec, spec);
+}
+
+void SpectralTransform::trig_plane_backward(double* spec, double* p, std::ptrdiff_t row,
+                                            PetscInt rows) {
+  if (plans_->trig_cols) plans_->trig_cols->backward(spec, spec);
+  for (PetscInt r = 0; r < rows; ++r)
+    plans_->trig->backward(spec + r * nx_, p + r * row);
 }
 
 } // namespace morphogen

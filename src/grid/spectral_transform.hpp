@@ -7,6 +7,9 @@
 // the rest, complex DFT on the slow axis), so symmetric stencils with cross terms stay diagonal.
 // Otherwise real r2r kinds: R2HC on periodic axes, REDFT10 on even and RODFT10 on odd axes
 // (backward HC2R, REDFT01, RODFT01). FFTW is unnormalised: backward(forward(u)) = norm() u.
+// The even and odd kinds are computed by TrigTransform (grid/trig_transform.hpp: one real or
+// paired complex FFT each, not FFTW's scalar r2r codelets) on the rest axes when none of them is
+// periodic, and on the slow axis when it is not.
 //
 // Parallel layout (slabs): layout A gives each rank a contiguous range of slow-axis planes,
 // where T_rest runs; layout B gives each rank a range of spectral columns (all slow-axis
@@ -88,6 +91,8 @@ private:
   void from_columns(); // layout B -> A
   void rest_forward(Vec u);
   void rest_backward(Vec u);
+  void trig_plane_forward(const double* p, std::ptrdiff_t row, PetscInt rows, double* spec);
+  void trig_plane_backward(double* spec, double* p, std::ptrdiff_t row, PetscInt rows);
   PetscInt S_ = 1, ncols_ = 1, ncolsS_ = 1;    // slow-axis cells, rest cells, rest spectral columns
   PetscInt nx_ = 1;                            // cells along x (a row of a plane)
   PetscInt a0_ = 0, a1_ = 0, b0_ = 0, nb_ = 0; // my slow planes [a0, a1), columns [b0, b0 + nb)
