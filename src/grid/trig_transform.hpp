@@ -42,8 +42,8 @@ private:
   double *cos_ = nullptr, *sin_ = nullptr; // cos, sin(pi k / 2n), k = 0 .. n/2
   double* v_ = nullptr;                    // the permuted sequences (n * howmany reals)
   double* c_ = nullptr;                    // their spectra ((n/2 + 1) * howmany complex)
-  void* fwd_ = nullptr;                    // fftw_plan r2c v -> c
-  void* bwd_ = nullptr;                    // fftw_plan c2r c -> v
+  void* fwd_ = nullptr; // fftw_plan v -> c: r2c (even howmany: complex DFT of column pairs)
+  void* bwd_ = nullptr; // fftw_plan c -> v: c2r (even howmany: complex inverse DFT)
 };
 
 } // namespace morphogen
