@@ -498,6 +498,12 @@ void Simulation::read_split(Options& opt) {
       "progress line or NaN check separates (n - 1 fewer reaction substeps per n steps, still "
       "second order; the trajectory then depends on the output times to splitting-error order, "
       "so restarts are not bitwise)");
+  set.fuse_planes = opt.flag(
+      "split_fuse_planes", true,
+      "fused Strang passes with every species' diffusion solved by the tridiagonal method in "
+      "place: each plane of the slowest axis takes its merged reaction substep just before the "
+      "diffusion's transform reads it, in cache (the same arithmetic as false: one pass over the "
+      "state less per step)");
   matrices_ = std::make_unique<OperatorMatrices>(*grid_, *halo_, stencil_, operators(),
                                                  dirichlet_.empty() ? nullptr : &dirichlet_);
   keep_timed_patterns();

@@ -221,6 +221,24 @@ bool DiffusionSolver::solve_local_begin(int s, Vec ulocal, double dt, double the
   return true;
 }
 
+bool DiffusionSolver::solve_local_planes_begin(const std::vector<VecH>& u, double dt, double theta,
+                                               const std::function<void(PetscInt)>& before) {
+  if (ops_.has_dirichlet()) return false;
+  std::vector<TridiagonalSolver::GroupMember> group;
+  for (int s = 0; s < ops_.nspecies(); ++s) {
+    if (ops_.scale(s) == 0.0) continue;
+    auto* t = use_spectral(s) ? dynamic_cast<TridiagonalSolver*>(spectral_[s].get()) : nullptr;
+    if (!t || !t->steps_local()) return false;
+    group.push_back({t, u[static_cast<size_t>(s)], dt * ops_.scale(s), theta});
+  }
+  if (group.empty()) return false;
+  LogScope log_scope(log_events().diffusion);
+  TridiagonalSolver::step_local_group_begin(group, before);
+  for (int s = 0; s < ops_.nspecies(); ++s)
+    iterations_[s] = 0;
+  return true;
+}
+
 void DiffusionSolver::solve_local_end(int s, Vec ulocal) {
   if (ops_.scale(s) == 0.0) return;
   LogScope log_scope(log_events().diffusion);

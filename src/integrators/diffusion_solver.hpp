@@ -33,6 +33,7 @@
 #include "operators/tridiagonal_solver.hpp"
 
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <petscksp.h>
 #include <string>
@@ -69,6 +70,13 @@ public:
   // solve_local would; after a true begin, call end before ulocal is used.
   bool solve_local_begin(int s, Vec ulocal, double dt, double theta);
   void solve_local_end(int s, Vec ulocal);
+  // Every species' solve_local_begin at once, where each diffusing species (at least one) is
+  // solved by the tridiagonal method in place: their first passes run in lockstep plane by plane
+  // of the slowest axis and before(g) is called once for every owned plane g (global index)
+  // before any solve reads it (TridiagonalSolver::step_local_group_begin). False (nothing done,
+  // before not called) elsewhere. After a true begin, solve_local_end for every species.
+  bool solve_local_planes_begin(const std::vector<VecH>& u, double dt, double theta,
+                                const std::function<void(PetscInt)>& before);
 
   // Species s's matrix was re-assembled (solution-dependent coefficients, lagged per step):
   // A_s is rebuilt on the next solve.

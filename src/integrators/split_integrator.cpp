@@ -27,75 +27,148 @@ SplitIntegrator::SplitIntegrator(const Grid& grid, ReactionRowFn fn,
   global_ = grid.create_global();
 }
 
-void SplitIntegrator::react(std::vector<VecH>& u, double t0, double dt, PetscInt step) {
-  LogScope log_scope(log_events().reaction);
-  if (params_.any_field()) // scalars may have changed (parameters using t)
-    params_.expand_scalars(static_cast<size_t>(grid_.owned().m[0]), const_rows_);
-  const int ns = static_cast<int>(species_.size());
-  const int np = static_cast<int>(params_.scalar.size());
-  std::vector<PetscScalar*> a(ns);
-  for (int s = 0; s < ns; ++s)
-    MG_PETSC(VecGetArray(u[s], &a[s]));
-  std::vector<const PetscScalar*> pf(np, nullptr);
-  for (int q = 0; q < np; ++q)
-    if (params_.field[q].get()) MG_PETSC(VecGetArrayRead(params_.field[q], &pf[q]));
-  std::vector<const double*> S0(ns, nullptr), S1(ns, nullptr);
+// The arrays and inputs of one reaction substep from t0 over dt (react_open .. react_close).
+struct SplitIntegrator::ReactionPass {
+  double t0 = 0, dt = 0;
+  PetscInt step = 0;
+  std::vector<PetscScalar*> a;
+  std::vector<const PetscScalar*> pf;
+  std::vector<const double*> S0, S1, in, prow, s0, s1;
+  std::vector<double*> out;
+  std::vector<double> zeros; // stands in for species without a source when others have one
   bool any_source = false;
-  if (sources_ && sources_->any())
-    for (int s = 0; s < ns; ++s) {
-      S0[s] = sources_->at(s, t0, 0);
-      S1[s] = sources_->at(s, t0 + dt, 1);
-      any_source |= S0[s] != nullptr;
-    }
-  // Rows of zeros stand in for species without a source when others have one.
-  std::vector<double> zeros(any_source ? static_cast<size_t>(grid_.owned().m[0]) : 0, 0.0);
-
-  const Box& ob = grid_.owned();
-  std::vector<const double*> in(ns), prow(np), s0(ns), s1(ns);
-  std::vector<double*> out(ns);
   std::string err;
   int worst_its = 0;
-  for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2] && err.empty(); ++k)
-    for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1] && err.empty(); ++j) {
-      const PetscInt c = grid_.local_index(ob.s[0], j, k);
-      const PetscInt o = grid_.owned_index(ob.s[0], j, k);
-      for (int s = 0; s < ns; ++s) {
-        in[s] = a[s] + c;
-        out[s] = a[s] + c; // in place (reaction rows read a cell before writing it)
-        s0[s] = S0[s] ? S0[s] + o : zeros.data();
-        s1[s] = S1[s] ? S1[s] + o : zeros.data();
-      }
-      for (int q = 0; q < np; ++q)
-        prow[q] = pf[q] ? pf[q] + o : const_rows_.empty() ? nullptr : const_rows_[q].data();
-      const PetscInt ahead = c + kPrefetchRowsAhead * grid_.ghosted().m[0];
-      if (prefetch_ && ahead + ob.m[0] <= grid_.ghosted().size())
-        for (int s = 0; s < ns; ++s)
-          prefetch_doubles(a[s] + ahead, ob.m[0]);
-      CellSolve worst{};
-      const int bad = fn_(set_.reaction, static_cast<int>(ob.m[0]), in.data(), prow.data(),
-                          params_.scalar.data(), any_source ? s0.data() : nullptr,
-                          any_source ? s1.data() : nullptr, dt, set_.newton_tol, set_.newton_max_it,
-                          floor_.data(), out.data(), &worst);
-      if (bad >= 0) {
-        std::ostringstream m;
-        m.precision(17);
-        m << "reaction solve failed at cell (" << ob.s[0] + bad << "," << j << "," << k
-          << ") at step " << step << " (t = " << t0 << "): values";
-        for (int s = 0; s < ns; ++s)
-          m << " " << species_[s] << " = " << in[s][bad];
-        m << ", residual " << worst.residual << " after " << worst.iterations
-          << " Newton iterations; reduce -dt or raise -split_newton_max_it";
-        err = m.str();
-        break;
-      }
-      worst_its = std::max(worst_its, worst.iterations);
+};
+
+void SplitIntegrator::react_open(ReactionPass& r, std::vector<VecH>& u, double t0, double dt,
+                                 PetscInt step) {
+  if (params_.any_field()) // scalars may have changed (parameters using t)
+    params_.expand_scalars(static_cast<size_t>(grid_.owned().m[0]), const_rows_);
+  const size_t ns = species_.size(), np = params_.scalar.size();
+  r.t0 = t0;
+  r.dt = dt;
+  r.step = step;
+  r.a.assign(ns, nullptr);
+  for (size_t s = 0; s < ns; ++s)
+    MG_PETSC(VecGetArray(u[s], &r.a[s]));
+  r.pf.assign(np, nullptr);
+  for (size_t q = 0; q < np; ++q)
+    if (params_.field[q].get()) MG_PETSC(VecGetArrayRead(params_.field[q], &r.pf[q]));
+  r.S0.assign(ns, nullptr);
+  r.S1.assign(ns, nullptr);
+  if (sources_ && sources_->any())
+    for (size_t s = 0; s < ns; ++s) {
+      r.S0[s] = sources_->at(static_cast<int>(s), t0, 0);
+      r.S1[s] = sources_->at(static_cast<int>(s), t0 + dt, 1);
+      r.any_source |= r.S0[s] != nullptr;
     }
-  for (int q = 0; q < np; ++q)
-    if (pf[q]) MG_PETSC(VecRestoreArrayRead(params_.field[q], &pf[q]));
-  for (int s = 0; s < ns; ++s)
-    MG_PETSC(VecRestoreArray(u[s], &a[s]));
-  last_its_ = worst_its;
-  throw_if_any(grid_.comm(), err);
+  r.zeros.assign(r.any_source ? static_cast<size_t>(grid_.owned().m[0]) : 0, 0.0);
+  r.in.resize(ns);
+  r.out.resize(ns);
+  r.s0.resize(ns);
+  r.s1.resize(ns);
+  r.prow.resize(np);
+}
+
+// Owned row (j, k) in place (reaction rows read a cell before writing it); a failure is kept in
+// r.err (and the rows after it are skipped).
+void SplitIntegrator::react_row(ReactionPass& r, PetscInt j, PetscInt k) {
+  if (!r.err.empty()) return;
+  const Box& ob = grid_.owned();
+  const size_t ns = species_.size();
+  const PetscInt c = grid_.local_index(ob.s[0], j, k);
+  const PetscInt o = grid_.owned_index(ob.s[0], j, k);
+  for (size_t s = 0; s < ns; ++s) {
+    r.in[s] = r.a[s] + c;
+    r.out[s] = r.a[s] + c;
+    r.s0[s] = r.S0[s] ? r.S0[s] + o : r.zeros.data();
+    r.s1[s] = r.S1[s] ? r.S1[s] + o : r.zeros.data();
+  }
+  for (size_t q = 0; q < r.prow.size(); ++q)
+    r.prow[q] = r.pf[q] ? r.pf[q] + o : const_rows_.empty() ? nullptr : const_rows_[q].data();
+  const PetscInt ahead = c + kPrefetchRowsAhead * grid_.ghosted().m[0];
+  if (prefetch_ && ahead + ob.m[0] <= grid_.ghosted().size())
+    for (size_t s = 0; s < ns; ++s)
+      prefetch_doubles(r.a[s] + ahead, ob.m[0]);
+  CellSolve worst{};
+  const int bad = fn_(set_.reaction, static_cast<int>(ob.m[0]), r.in.data(), r.prow.data(),
+                      params_.scalar.data(), r.any_source ? r.s0.data() : nullptr,
+                      r.any_source ? r.s1.data() : nullptr, r.dt, set_.newton_tol,
+                      set_.newton_max_it, floor_.data(), r.out.data(), &worst);
+  if (bad >= 0) {
+    std::ostringstream m;
+    m.precision(17);
+    m << "reaction solve failed at cell (" << ob.s[0] + bad << "," << j << "," << k << ") at step "
+      << r.step << " (t = " << r.t0 << "): values";
+    for (size_t s = 0; s < ns; ++s)
+      m << " " << species_[s] << " = " << r.in[s][bad];
+    m << ", residual " << worst.residual << " after " << worst.iterations
+      << " Newton iterations; reduce -dt or raise -split_newton_max_it";
+    r.err = m.str();
+    return;
+  }
+  r.worst_its = std::max(r.worst_its, worst.iterations);
+}
+
+// The arrays back; a failure on any rank is thrown on every rank.
+void SplitIntegrator::react_close(ReactionPass& r, std::vector<VecH>& u) {
+  for (size_t q = 0; q < r.pf.size(); ++q)
+    if (r.pf[q]) MG_PETSC(VecRestoreArrayRead(params_.field[q], &r.pf[q]));
+  for (size_t s = 0; s < species_.size(); ++s)
+    MG_PETSC(VecRestoreArray(u[s], &r.a[s]));
+  last_its_ = r.worst_its;
+  throw_if_any(grid_.comm(), r.err);
+}
+
+void SplitIntegrator::react(std::vector<VecH>& u, double t0, double dt, PetscInt step) {
+  LogScope log_scope(log_events().reaction);
+  ReactionPass r;
+  react_open(r, u, t0, dt, step);
+  const Box& ob = grid_.owned();
+  for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
+    for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j)
+      react_row(r, j, k);
+  react_close(r, u);
+}
+
+// react (of step `step`), then diffuse (of the next step); where every species' diffusion is a
+// tridiagonal solve in place (and no constraint acts between the two), in one pass: each plane of
+// the slowest axis reacts just before the solves' transforms read it
+// (DiffusionSolver::solve_local_planes_begin), while it is in cache. The same arithmetic either
+// way.
+void SplitIntegrator::react_diffuse(std::vector<VecH>& u, double t0, double dt_react,
+                                    double dt_diffuse, PetscInt step) {
+  const bool constrained = terms_ && !terms_->constraints().empty();
+  if (constrained || !set_.fuse_planes) {
+    react(u, t0, dt_react, step);
+    if (terms_) terms_->constrain(u);
+    diffuse(u, dt_diffuse, step + 1);
+    return;
+  }
+  ReactionPass r;
+  react_open(r, u, t0, dt_react, step);
+  const Box& ob = grid_.owned();
+  auto plane = [&](PetscInt g) {
+    LogScope log_scope(log_events().reaction);
+    if (grid_.dim() == 3)
+      for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j)
+        react_row(r, j, g);
+    else
+      react_row(r, g, ob.s[2]);
+  };
+  if (!diffusion_.solve_local_planes_begin(u, dt_diffuse, set_.theta, plane)) {
+    for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
+      for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j)
+        react_row(r, j, k);
+    react_close(r, u);
+    diffuse(u, dt_diffuse, step + 1);
+    return;
+  }
+  for (size_t s = 0; s < u.size(); ++s)
+    diffusion_.solve_local_end(static_cast<int>(s), u[s]);
+  react_close(r, u);
+  ++planes_fused_;
 }
 
 void SplitIntegrator::diffuse(std::vector<VecH>& u, double dt, PetscInt step) {
@@ -190,12 +263,12 @@ void SplitIntegrator::steps(std::vector<VecH>& u, double t, double dt, PetscInt 
   }
   react(u, t, 0.5 * dt, first);
   if (terms_) terms_->constrain(u);
-  for (int i = 0; i < n; ++i) {
-    diffuse(u, dt, first + i);
-    // The merged substep spans the second half of step i and the first half of step i + 1.
-    react(u, t + (i + 0.5) * dt, i + 1 < n ? dt : 0.5 * dt, first + i);
-    if (terms_) terms_->constrain(u);
-  }
+  diffuse(u, dt, first);
+  // The merged substep spans the second half of step i and the first half of step i + 1.
+  for (int i = 0; i + 1 < n; ++i)
+    react_diffuse(u, t + (i + 0.5) * dt, dt, dt, first + i);
+  react(u, t + (n - 0.5) * dt, 0.5 * dt, first + n - 1);
+  if (terms_) terms_->constrain(u);
   constrain(u);
 }
 

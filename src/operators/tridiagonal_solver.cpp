@@ -385,45 +385,55 @@ void TridiagonalSolver::apply(Vec r, Vec x, double s0, double s1) {
 
 // Plane by plane: the transform, the right-hand side (s0 f + s1 M f) / norm (the neighbours'
 // edge planes exchanged first; the transform's 1/norm folded in), the forward elimination of
-// the interior rows.
+// the interior rows. down_plane(j) transforms plane j + 1 (with the product; else plane j), and
+// down_begin planes 0 and m - 1.
 void TridiagonalSolver::down(const PlaneView& in, double s0, double s1) {
-  const PetscInt ni = m_ - 2;
-  const bool product = s1 != 0.0;
-  s0 /= t_->norm();
-  s1 /= t_->norm();
+  down_begin(in, s0, s1);
+  for (PetscInt j = 0; j < m_; ++j)
+    down_plane(in, j);
+  down_end();
+}
+
+void TridiagonalSolver::down_begin(const PlaneView& in, double s0, double s1) {
+  product_ = s1 != 0.0;
+  s0_ = s0 / t_->norm();
+  s1_ = s1 / t_->norm();
+  if (!product_) return;
   const size_t n = static_cast<size_t>(n_);
-  if (product) {
-    t_->plane_forward(in, 0, row(0));
-    t_->plane_forward(in, m_ - 1, row(m_ - 1));
-    begin_edges(); // arrive while the planes between are transformed (hi_ used at m - 1, lo_ last)
-    prev_.resize(n);
-    cur_.resize(n);
-    raw1_.resize(n);
+  t_->plane_forward(in, 0, row(0));
+  t_->plane_forward(in, m_ - 1, row(m_ - 1));
+  begin_edges(); // arrive while the planes between are transformed (hi_ used at m - 1, lo_ last)
+  prev_.resize(n);
+  cur_.resize(n);
+  raw1_.resize(n);
+}
+
+void TridiagonalSolver::down_plane(const PlaneView& in, PetscInt j) {
+  double* y = row(j);
+  if (product_) {
+    if (j + 3 < m_ - 1)
+      for (PetscInt r = 0; r < in.rows; ++r)
+        prefetch_doubles(in.base + (j + 3) * in.plane + r * in.row, in.len);
+    if (j + 1 < m_ - 1) t_->plane_forward(in, j + 1, row(j + 1));
+    if (j == m_ - 1) end_edges();
+    std::copy(y, y + n_, cur_.begin());
+    if (j == 0) // row 0's product waits for lo_ (down_end); row 1 as it is now
+      std::copy(row(1), row(1) + n_, raw1_.begin());
+    else
+      tri_multiply_row(n_, s0_, s1_, a_.data(), diagonal(j), g_.data(), prev_.data(), cur_.data(),
+                       j + 1 < m_ ? row(j + 1) : hi_.data(), y);
+    std::swap(prev_, cur_);
+  } else {
+    t_->plane_forward(in, j, y);
+    tri_scale_row(n_, s0_, y);
   }
-  for (PetscInt j = 0; j < m_; ++j) {
-    double* y = row(j);
-    if (product) {
-      if (j + 3 < m_ - 1)
-        for (PetscInt r = 0; r < in.rows; ++r)
-          prefetch_doubles(in.base + (j + 3) * in.plane + r * in.row, in.len);
-      if (j + 1 < m_ - 1) t_->plane_forward(in, j + 1, row(j + 1));
-      if (j == m_ - 1) end_edges();
-      std::copy(y, y + n_, cur_.begin());
-      if (j == 0) // row 0's product waits for lo_ (below); row 1 as it is now
-        std::copy(row(1), row(1) + n_, raw1_.begin());
-      else
-        tri_multiply_row(n_, s0, s1, a_.data(), diagonal(j), g_.data(), prev_.data(), cur_.data(),
-                         j + 1 < m_ ? row(j + 1) : hi_.data(), y);
-      std::swap(prev_, cur_);
-    } else {
-      t_->plane_forward(in, j, y);
-      tri_scale_row(n_, s0, y);
-    }
-    if (j >= 1 && j <= ni)
-      tri_forward_row(n_, ia_.data(), inv_row(j - 1), j > 1 ? row(j - 1) : nullptr, y);
-  }
-  if (product) // row 0 is no interior row: the elimination above did not use it
-    tri_multiply_row(n_, s0, s1, a_.data(), diagonal(0), g_.data(), lo_.data(), row(0),
+  if (j >= 1 && j <= m_ - 2)
+    tri_forward_row(n_, ia_.data(), inv_row(j - 1), j > 1 ? row(j - 1) : nullptr, y);
+}
+
+void TridiagonalSolver::down_end() {
+  if (product_) // row 0 is no interior row: the elimination did not use it
+    tri_multiply_row(n_, s0_, s1_, a_.data(), diagonal(0), g_.data(), lo_.data(), row(0),
                      raw1_.data(), row(0));
 }
 
@@ -496,8 +506,8 @@ void TridiagonalSolver::step_local(Vec ulocal, double c, double theta) {
   step_local_end(ulocal);
 }
 
-// Transform, elimination and back substitution; the reduced system's allgather posted.
-void TridiagonalSolver::step_local_begin(Vec ulocal, double c, double theta) {
+// local_ = the owned planes of ulocal (its array held until step_local_end), the factors set.
+void TridiagonalSolver::map_local(Vec ulocal, double c, double theta) {
   if (!t_->direct()) throw std::logic_error("TridiagonalSolver::step_local: not slabs");
   factor(c, theta);
   const Box& gb = grid_.ghosted();
@@ -509,9 +519,42 @@ void TridiagonalSolver::step_local_begin(Vec ulocal, double c, double theta) {
   local_.plane = three ? gb.m[0] * gb.m[1] : gb.m[0];
   local_.rows = three ? grid_.spec().n[1] : 1;
   local_.len = grid_.spec().n[0];
+}
+
+// Transform, elimination and back substitution; the reduced system's allgather posted.
+void TridiagonalSolver::step_local_begin(Vec ulocal, double c, double theta) {
+  map_local(ulocal, c, theta);
   down(local_, 1.0, explicit_part(c, theta));
   up(local_);
   ends_begin();
+}
+
+// step_local_begin of every member, their down passes in lockstep plane by plane; before(g) is
+// called for every owned plane g (global index) before any member's transform reads it.
+void TridiagonalSolver::step_local_group_begin(const std::vector<GroupMember>& group,
+                                               const std::function<void(PetscInt)>& before) {
+  if (group.empty()) return;
+  TridiagonalSolver& first = *group.front().solver;
+  const PetscInt a0 = first.a0_, m = first.m_;
+  for (const GroupMember& g : group) {
+    if (g.solver->a0_ != a0 || g.solver->m_ != m)
+      throw std::logic_error("TridiagonalSolver::step_local_group_begin: different planes");
+    g.solver->map_local(g.ulocal, g.c, g.theta);
+  }
+  before(a0);
+  before(a0 + m - 1);
+  for (const GroupMember& g : group)
+    g.solver->down_begin(g.solver->local_, 1.0, explicit_part(g.c, g.theta));
+  for (PetscInt j = 0; j < m; ++j) {
+    if (j + 1 < m - 1) before(a0 + j + 1); // down_plane(j) reads plane j + 1 at the latest
+    for (const GroupMember& g : group)
+      g.solver->down_plane(g.solver->local_, j);
+  }
+  for (const GroupMember& g : group) {
+    g.solver->down_end();
+    g.solver->up(g.solver->local_);
+    g.solver->ends_begin();
+  }
 }
 
 void TridiagonalSolver::step_local_end(Vec ulocal) {

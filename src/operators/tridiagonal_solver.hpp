@@ -27,7 +27,9 @@
 // each plane in cache between its steps; the spikes decay geometrically and are kept only
 // where they exceed 2^-64 (truncate_spikes). Waits are late: the edge planes travel while the
 // down pass runs (the first row's product is formed last), and step_local_begin / _end let the
-// reduced system's allgather of one species overlap the next species' passes (SplitIntegrator).
+// reduced system's allgather of one species overlap the next species' passes (SplitIntegrator);
+// step_local_group_begin runs several species' down passes in lockstep, plane by plane, with a
+// caller's hook before each plane is first read (the split integrator's merged reaction).
 // Back substitution writes the rows it emits at once to scratch rows (the spectrum's cache
 // lines stay clean), and the down pass prefetches the state's planes three ahead. create()
 // returns null and says why where it does not apply (at most kMaxRanks ranks, S >= 3 planes);
@@ -38,6 +40,7 @@
 #include "operators/exact_solve.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <memory>
 #include <petscmat.h>
 #include <string>
@@ -60,6 +63,20 @@ public:
   void step_local_begin(Vec ulocal, double c, double theta) override;
   void step_local_end(Vec ulocal) override;
   std::string method() const override;
+
+  // One species' substep in a group of solvers on the same grid (step_local_group_begin).
+  struct GroupMember {
+    TridiagonalSolver* solver;
+    Vec ulocal;
+    double c, theta;
+  };
+  // step_local_begin for every member at once, their down passes in lockstep plane by plane:
+  // before(g) is called once for every owned plane g of the slowest axis (global index) before
+  // any member's transform reads it, so that the caller can update the plane's cells of every
+  // species there while they are in cache (the split integrator's reaction). Then
+  // step_local_end for each member.
+  static void step_local_group_begin(const std::vector<GroupMember>& group,
+                                     const std::function<void(PetscInt)>& before);
 
 private:
   TridiagonalSolver(const Grid& grid, std::unique_ptr<SpectralTransform> t);
@@ -86,6 +103,10 @@ private:
   // rows the spikes do not reach go back to x at once), ends (reduced system, the other rows).
   void apply(Vec r, Vec x, double s0, double s1);
   void down(const PlaneView& in, double s0, double s1);
+  void down_begin(const PlaneView& in, double s0, double s1);
+  void down_plane(const PlaneView& in, PetscInt j);
+  void down_end();
+  void map_local(Vec ulocal, double c, double theta);
   void up(const PlaneView& out);
   void ends_begin(); // the reduced system's right-hand sides, their allgather posted
   void ends(const PlaneView& out);
@@ -115,6 +136,8 @@ private:
   std::vector<double> prev_, cur_, zero_, F_, E_; // one row each
   std::vector<double> xs_;                        // up()'s two scratch rows
   std::vector<double> raw1_; // down(): plane 1 before its product (row 0's product needs it)
+  bool product_ = false;     // down(): with the explicit product, its scales (1/norm folded in)
+  double s0_ = 0.0, s1_ = 0.0;
   MPI_Request edge_req_[4] = {MPI_REQUEST_NULL, MPI_REQUEST_NULL, MPI_REQUEST_NULL,
                               MPI_REQUEST_NULL};
   size_t scratch_stride() const { return (static_cast<size_t>(n_) + 7) / 8 * 8; }
