@@ -91,15 +91,13 @@ bool run_loop(Simulation& sim, PetscInt end_step, RunOutput& output, PngOutput& 
       step_last = n;
     }
   }
-  if (sim.fuse_steps() > 1) {
-    const SplitIntegrator* split = sim.split_integrator();
-    const long in_pass = split ? split->planes_fused_substeps() : 0;
-    PetscPrintf(comm,
-                "fused steps: %lld steps in %lld passes (up to %lld steps each); %ld merged "
-                "reaction substeps inside the diffusion's pass\n",
+  if (sim.fuse_steps() > 1)
+    PetscPrintf(comm, "fused steps: %lld steps in %lld passes (up to %lld steps each)\n",
                 static_cast<long long>(steps), static_cast<long long>(passes),
-                static_cast<long long>(std::min(sim.fuse_steps(), steps)), in_pass);
-  }
+                static_cast<long long>(std::min(sim.fuse_steps(), steps)));
+  if (const SplitIntegrator* split = sim.split_integrator())
+    PetscPrintf(comm, "split: %ld reaction substeps inside the diffusion's pass\n",
+                split->planes_fused_substeps());
   const std::string width = sim.explicit_vector_width();
   if (!width.empty() && wide_vectors_available())
     PetscPrintf(comm, "explicit kernel (rank 0): %s\n", width.c_str());

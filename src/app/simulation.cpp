@@ -500,10 +500,10 @@ void Simulation::read_split(Options& opt) {
       "so restarts are not bitwise)");
   set.fuse_planes = opt.flag(
       "split_fuse_planes", true,
-      "fused Strang passes with every species' diffusion solved by the tridiagonal method in "
-      "place: each plane of the slowest axis takes its merged reaction substep just before the "
-      "diffusion's transform reads it, in cache (the same arithmetic as false: one pass over the "
-      "state less per step)");
+      "where every diffusing species is solved by the tridiagonal method in place, a reaction "
+      "substep followed by a diffusion substep runs inside the latter's first pass, each plane of "
+      "the slowest axis just before the transforms read it, in cache (the same arithmetic as "
+      "false: one pass over the state less per step)");
   matrices_ = std::make_unique<OperatorMatrices>(*grid_, *halo_, stencil_, operators(),
                                                  dirichlet_.empty() ? nullptr : &dirichlet_);
   keep_timed_patterns();

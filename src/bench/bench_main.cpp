@@ -299,9 +299,9 @@ void bench_reaction_kernel(MPI_Comm comm) {
 
 // A split step (auto: the exact transform solve where it applies, and KSP) against an explicit
 // step on the same grid and ranks, Brusselator deck settings at n^2. Each split case's blocks
-// (`steps` steps; the fused cases one pass of them) alternate with blocks of the explicit run
-// (20 times as many steps), best of 5 each: the ratio of two bests taken in the same minutes.
-void bench_split_vs_explicit(MPI_Comm comm, Options& opt, int n, int steps) {
+// (`steps` steps; the fused cases one pass of `pass` steps) alternate with blocks of the explicit
+// run (20 times as many steps), best of 5 each: the ratio of two bests taken in the same minutes.
+void bench_split_vs_explicit(MPI_Comm comm, Options& opt, int n, int steps, int pass) {
   const int ex_steps = std::max(10, steps * 20), reps = 5;
   const std::unique_ptr<Simulation> ex =
       warm_run(comm, opt, brusselator_deck(n, "explicit", "0.0025"));
@@ -313,7 +313,7 @@ void bench_split_vs_explicit(MPI_Comm comm, Options& opt, int n, int steps) {
                             ex_steps};
   auto compare = [&](const OptionPairs& o, bool fused, const std::string& label) {
     const std::unique_ptr<Simulation> sp = warm_run(comm, opt, o);
-    const int k = fused ? static_cast<int>(std::min<PetscInt>(steps, sp->fuse_steps())) : steps;
+    const int k = fused ? static_cast<int>(std::min<PetscInt>(pass, sp->fuse_steps())) : steps;
     const TimedBlock block{[&] { sp->step(); },
                            [&] {
                              if (fused)
@@ -471,6 +471,10 @@ int run(MPI_Comm comm) {
       opt.flag("bench_split", true, "also time the split integrator (CN + implicit reaction)");
   const PetscInt split_steps =
       opt.integer("bench_steps_split", 5, 1, 100000, "timed split steps per preconditioner");
+  const PetscInt split_pass = opt.integer(
+      "bench_split_pass", 20, 1, 100000,
+      "steps per timed pass of the fused split_vs_explicit cases (a run fuses the steps between "
+      "two observations of its state: NaN checks every 100 steps by default)");
   const PetscInt mb =
       opt.integer("bench_stream_mb", 256, 8, 65536, "STREAM array size per rank, MiB");
   const bool with_implicit =
@@ -530,9 +534,11 @@ int run(MPI_Comm comm) {
   if (only_fused) return 0;
   if (with_implicit) {
     bench_reaction_kernel(comm);
-    bench_split_vs_explicit(comm, opt, 256, static_cast<int>(split_steps) * 4);
+    bench_split_vs_explicit(comm, opt, 256, static_cast<int>(split_steps) * 4,
+                            static_cast<int>(split_pass));
     opt.check_unused();
-    bench_split_vs_explicit(comm, opt, 1024, static_cast<int>(split_steps));
+    bench_split_vs_explicit(comm, opt, 1024, static_cast<int>(split_steps),
+                            static_cast<int>(split_pass));
     if (deck_T > 0) bench_brusselator_deck(comm, opt, deck_T, deck_split_dt, deck_ts);
   }
   if (only_implicit) return 0;

@@ -132,22 +132,22 @@ void SplitIntegrator::react(std::vector<VecH>& u, double t0, double dt, PetscInt
   react_close(r, u);
 }
 
-// react (of step `step`), then diffuse (of the next step); where every species' diffusion is a
-// tridiagonal solve in place (and no constraint acts between the two), in one pass: each plane of
-// the slowest axis reacts just before the solves' transforms read it
-// (DiffusionSolver::solve_local_planes_begin), while it is in cache. The same arithmetic either
-// way.
+// react (from t0 over dt_react, of step react_step), then diffuse (over dt_diffuse, of step
+// diffuse_step); where every species' diffusion is a tridiagonal solve in place (and no
+// constraint acts between the two), in one pass: each plane of the slowest axis reacts just
+// before the solves' transforms read it (DiffusionSolver::solve_local_planes_begin), while it is
+// in cache. The same arithmetic either way.
 void SplitIntegrator::react_diffuse(std::vector<VecH>& u, double t0, double dt_react,
-                                    double dt_diffuse, PetscInt step) {
+                                    PetscInt react_step, double dt_diffuse, PetscInt diffuse_step) {
   const bool constrained = terms_ && !terms_->constraints().empty();
   if (constrained || !set_.fuse_planes) {
-    react(u, t0, dt_react, step);
+    react(u, t0, dt_react, react_step);
     if (terms_) terms_->constrain(u);
-    diffuse(u, dt_diffuse, step + 1);
+    diffuse(u, dt_diffuse, diffuse_step);
     return;
   }
   ReactionPass r;
-  react_open(r, u, t0, dt_react, step);
+  react_open(r, u, t0, dt_react, react_step);
   const Box& ob = grid_.owned();
   auto plane = [&](PetscInt g) {
     LogScope log_scope(log_events().reaction);
@@ -162,7 +162,7 @@ void SplitIntegrator::react_diffuse(std::vector<VecH>& u, double t0, double dt_r
       for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j)
         react_row(r, j, k);
     react_close(r, u);
-    diffuse(u, dt_diffuse, step + 1);
+    diffuse(u, dt_diffuse, diffuse_step);
     return;
   }
   for (size_t s = 0; s < u.size(); ++s)
@@ -229,8 +229,15 @@ void SplitIntegrator::step(std::vector<VecH>& u, double t, double dt, PetscInt s
       diffusion_.operator_changed(s);
   }
   double t_reaction = t; // the reaction's (and sources') clock advances with its substeps
-  for (const Substep& sub : substeps_) {
-    if (sub.kind == Substep::Kind::Reaction) {
+  for (size_t i = 0; i < substeps_.size(); ++i) {
+    const Substep& sub = substeps_[i];
+    const bool then_diffuse =
+        i + 1 < substeps_.size() && substeps_[i + 1].kind == Substep::Kind::Diffusion;
+    if (sub.kind == Substep::Kind::Reaction && then_diffuse) {
+      react_diffuse(u, t_reaction, sub.fraction * dt, step, substeps_[i + 1].fraction * dt, step);
+      t_reaction += sub.fraction * dt;
+      ++i;
+    } else if (sub.kind == Substep::Kind::Reaction) {
       react(u, t_reaction, sub.fraction * dt, step);
       t_reaction += sub.fraction * dt;
       if (terms_) terms_->constrain(u);
@@ -261,12 +268,10 @@ void SplitIntegrator::steps(std::vector<VecH>& u, double t, double dt, PetscInt 
       step(u, t + i * dt, dt, first + i);
     return;
   }
-  react(u, t, 0.5 * dt, first);
-  if (terms_) terms_->constrain(u);
-  diffuse(u, dt, first);
+  react_diffuse(u, t, 0.5 * dt, first, dt, first);
   // The merged substep spans the second half of step i and the first half of step i + 1.
   for (int i = 0; i + 1 < n; ++i)
-    react_diffuse(u, t + (i + 0.5) * dt, dt, dt, first + i);
+    react_diffuse(u, t + (i + 0.5) * dt, dt, first + i, dt, first + i + 1);
   react(u, t + (n - 0.5) * dt, 0.5 * dt, first + n - 1);
   if (terms_) terms_->constrain(u);
   constrain(u);

@@ -21,9 +21,10 @@
 //   R(dt/2) D(dt) [R(dt) D(dt)]^(n-1) R(dt/2),
 // the same order (second) with n - 1 fewer reaction substeps; a pass of 1 step is step(). Where
 // every species' diffusion is the in-place tridiagonal solve and no constraint acts between the
-// substeps, each merged R(dt) runs inside the next D(dt)'s first pass, plane by plane of the
-// slowest axis just before the transforms read the plane (SplitSettings::fuse_planes): the same
-// arithmetic (bitwise the same states), one pass over the state less per step.
+// substeps, a reaction substep followed by a diffusion substep (the first R of a step, a merged
+// R(dt)) runs inside the diffusion's first pass, plane by plane of the slowest axis just before
+// the transforms read the plane (SplitSettings::fuse_planes): the same arithmetic (bitwise the
+// same states), one pass over the state less per step.
 #pragma once
 
 #include "fields/param_set.hpp"
@@ -62,7 +63,7 @@ struct SplitSettings {
   double theta = 0.5; // diffusion: 1 backward Euler, 0.5 Crank-Nicolson
   double newton_tol = 1e-12;
   int newton_max_it = 20;
-  bool fuse_planes = true; // fused passes: merged reaction substeps inside the diffusion's pass
+  bool fuse_planes = true; // a reaction substep before a diffusion one inside the latter's pass
 };
 
 class SplitIntegrator : public Integrator {
@@ -87,7 +88,7 @@ public:
 
   // Largest Newton iteration count of the last reaction substep.
   int last_newton_iterations() const { return last_its_; }
-  // Merged reaction substeps taken inside the diffusion's pass so far (SplitSettings::fuse_planes).
+  // Reaction substeps taken inside the diffusion's pass so far (SplitSettings::fuse_planes).
   long planes_fused_substeps() const { return planes_fused_; }
 
 private:
@@ -96,8 +97,8 @@ private:
   void react_open(ReactionPass& r, std::vector<VecH>& u, double t0, double dt, PetscInt step);
   void react_row(ReactionPass& r, PetscInt j, PetscInt k);
   void react_close(ReactionPass& r, std::vector<VecH>& u);
-  void react_diffuse(std::vector<VecH>& u, double t0, double dt_react, double dt_diffuse,
-                     PetscInt step);
+  void react_diffuse(std::vector<VecH>& u, double t0, double dt_react, PetscInt react_step,
+                     double dt_diffuse, PetscInt diffuse_step);
   void diffuse(std::vector<VecH>& u, double dt, PetscInt step);
   void constrain(std::vector<VecH>& u) const;
 
