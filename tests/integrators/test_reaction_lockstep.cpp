@@ -257,6 +257,52 @@ TYPED_TEST(LockstepModels, ExplicitRowsAreBitwiseThePerCellPath) {
 }
 
 // The 3x3 Cramer solve against a hand-checked system, and its singularity test.
+// In place (out aliases u), a non-finite cell in a full 16-cell chunk and in the row's last
+// partial chunk: the index is reported, the cells before it hold the values of a run without it
+// (out apart), it and the cells after it keep their inputs.
+TYPED_TEST(LockstepModels, ExplicitRowInPlaceStopsAtTheFirstNonFiniteCell) {
+  using M = TypeParam;
+  constexpr int NS = M::nspecies;
+  const int n = 40; // two full chunks and 8 cells
+  const std::vector<double> floor(NS, -HUGE_VAL);
+  for (int at : {21, 36})
+    for (ReactionScheme scheme :
+         {ReactionScheme::Euler, ReactionScheme::Heun, ReactionScheme::Rk4}) {
+      SCOPED_TRACE("non-finite cell " + std::to_string(at));
+      Row<M> row(n);
+      const double dt = 0.3 / row.jnorm;
+      std::vector<std::vector<double>> ref(NS, std::vector<double>(n));
+      std::vector<double*> pr;
+      for (int s = 0; s < NS; ++s)
+        pr.push_back(ref[s].data());
+      CellSolve w{};
+      const auto u0 = Row<M>::ptrs(row.u);
+      const int r0 =
+          reaction_row_lockstep<M, false>(scheme, n, u0.data(), nullptr, row.pdef.data(), nullptr,
+                                          nullptr, dt, 1e-12, 20, floor.data(), pr.data(), &w);
+      ASSERT_EQ(r0, -1);
+      auto v = row.u;
+      v[0][static_cast<size_t>(at)] = std::nan("");
+      const auto before = v;
+      std::vector<double*> pv;
+      for (int s = 0; s < NS; ++s)
+        pv.push_back(v[s].data());
+      const std::vector<const double*> in(pv.begin(), pv.end());
+      const int r1 =
+          reaction_row_lockstep<M, false>(scheme, n, in.data(), nullptr, row.pdef.data(), nullptr,
+                                          nullptr, dt, 1e-12, 20, floor.data(), pv.data(), &w);
+      EXPECT_EQ(r1, at);
+      for (int s = 0; s < NS; ++s)
+        for (int i = 0; i < n; ++i) {
+          const double want = i < at ? ref[s][i] : before[s][i];
+          if (std::isnan(want))
+            EXPECT_TRUE(std::isnan(v[s][i])) << "species " << s << " cell " << i;
+          else
+            EXPECT_EQ(v[s][i], want) << "species " << s << " cell " << i;
+        }
+    }
+}
+
 TEST(LockstepCramer, SolvesAndDetectsSingular) {
   const double A[9] = {4, 1, 0, 1, 3, 1, 0, 1, 2}, b[3] = {1, 2, 3};
   double x[3];
