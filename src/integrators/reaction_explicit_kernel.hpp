@@ -144,14 +144,7 @@ MG_LANES_WIDE inline int explicit_row(int n, const double* const* u, const doubl
       all = all < fin[l] ? all : fin[l];
     if (all == 0.0)
       return explicit_row_from<M, FieldParams, S>(i0, n, u, prow, pconst, S0, S1, dt, floor, out);
-#pragma GCC unroll 16
-    for (int s = 0; s < NS; ++s) {
-      const double f = floor[s];
-      double* o = out[s] + i0;
-#pragma GCC ivdep
-      for (int l = 0; l < W; ++l)
-        o[l] = clamp_to_floor(v[s][l], f);
-    }
+    store_clamped<NS, W>(v, i0, floor, out);
   }
   return full == n ? -1
                    : explicit_row_from<M, FieldParams, S>(full, n, u, prow, pconst, S0, S1, dt,

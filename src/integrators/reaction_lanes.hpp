@@ -4,6 +4,8 @@
 // result does not depend on where in a row, or on which rank, it lies.
 #pragma once
 
+#include "fields/clamp_kernel.hpp"
+
 #include <cfloat>
 #include <cmath>
 
@@ -24,6 +26,20 @@ inline bool finite_d(double x) {
 // 1.0 where x is finite, 0.0 for NaN and inf (a select, so that the lane loops vectorise).
 inline double finite_mask(double x) {
   return std::fabs(x) <= DBL_MAX ? 1.0 : 0.0;
+}
+
+// Cells [i0, i0 + W) of the output rows from a full chunk's values v, clamped to floor.
+template <int NS, int W>
+inline void store_clamped(const double (&v)[NS][W], int i0, const double* floor,
+                          double* const* out) {
+#pragma GCC unroll 16
+  for (int s = 0; s < NS; ++s) {
+    const double f = floor[s];
+    double* o = out[s] + i0;
+#pragma GCC ivdep
+    for (int l = 0; l < W; ++l)
+      o[l] = clamp_to_floor(v[s][l], f);
+  }
 }
 
 // The W lanes of one chunk (structure of arrays): inputs, iterate and per-lane state (0/1

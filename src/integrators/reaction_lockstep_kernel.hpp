@@ -205,14 +205,7 @@ template <int NS, int NP, int W> inline bool lockstep_all_done(const LockstepLan
 template <int NS, int NP, int W>
 inline void lockstep_store(const LockstepLanes<NS, NP, W>& L, int i0, const double* floor,
                            double* const* out, double* its_max, double* res_max) {
-#pragma GCC unroll 16
-  for (int s = 0; s < NS; ++s) {
-    const double f = floor[s];
-    double* o = out[s] + i0;
-#pragma GCC ivdep
-    for (int l = 0; l < W; ++l)
-      o[l] = clamp_to_floor(L.v[s][l], f);
-  }
+  store_clamped<NS, W>(L.v, i0, floor, out);
 #pragma GCC ivdep
   for (int l = 0; l < W; ++l) {
     its_max[l] = L.its[l] > its_max[l] ? L.its[l] : its_max[l];
