@@ -122,14 +122,19 @@ void SplitIntegrator::react_close(ReactionPass& r, std::vector<VecH>& u) {
 }
 
 void SplitIntegrator::react(std::vector<VecH>& u, double t0, double dt, PetscInt step) {
-  LogScope log_scope(log_events().reaction);
   ReactionPass r;
   react_open(r, u, t0, dt, step);
+  react_rows(r);
+  react_close(r, u);
+}
+
+// Every owned row of the pass.
+void SplitIntegrator::react_rows(ReactionPass& r) {
+  LogScope log_scope(log_events().reaction);
   const Box& ob = grid_.owned();
   for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
     for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j)
       react_row(r, j, k);
-  react_close(r, u);
 }
 
 // react (from t0 over dt_react, of step react_step), then diffuse (over dt_diffuse, of step
@@ -158,9 +163,7 @@ void SplitIntegrator::react_diffuse(std::vector<VecH>& u, double t0, double dt_r
       react_row(r, g, ob.s[2]);
   };
   if (!diffusion_.solve_local_planes_begin(u, dt_diffuse, set_.theta, plane)) {
-    for (PetscInt k = ob.s[2]; k < ob.s[2] + ob.m[2]; ++k)
-      for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j)
-        react_row(r, j, k);
+    react_rows(r);
     react_close(r, u);
     diffuse(u, dt_diffuse, diffuse_step);
     return;

@@ -96,6 +96,7 @@ private:
   void react(std::vector<VecH>& u, double t0, double dt, PetscInt step);
   void react_open(ReactionPass& r, std::vector<VecH>& u, double t0, double dt, PetscInt step);
   void react_row(ReactionPass& r, PetscInt j, PetscInt k);
+  void react_rows(ReactionPass& r);
   void react_close(ReactionPass& r, std::vector<VecH>& u);
   void react_diffuse(std::vector<VecH>& u, double t0, double dt_react, PetscInt react_step,
                      double dt_diffuse, PetscInt diffuse_step);
