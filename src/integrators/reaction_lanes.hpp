@@ -16,6 +16,13 @@
 #else
 #define MG_LANES_WIDE
 #endif
+// A lane loop forced inline into its caller's chunk loop (GCC 12 left the Newton step an
+// out-of-line call; inlined, the lockstep row is about 7 % faster).
+#if defined(__GNUC__)
+#define MG_LANES_INLINE inline __attribute__((always_inline))
+#else
+#define MG_LANES_INLINE inline
+#endif
 
 namespace morphogen::detail {
 

@@ -125,8 +125,8 @@ MG_LANES_WIDE inline void lockstep_start(LockstepLanes<NS, NP, W>& L, double tra
 // One full Newton step on every active lane (branch-free: every lane computes, selects keep
 // the finished ones).
 template <class M, int NS, int NP, int W>
-MG_LANES_WIDE inline void lockstep_newton(LockstepLanes<NS, NP, W>& L, double cdt, double tol,
-                                          double big, double it) {
+MG_LANES_WIDE MG_LANES_INLINE void lockstep_newton(LockstepLanes<NS, NP, W>& L, double cdt,
+                                                   double tol, double big, double it) {
 #pragma GCC ivdep
   for (int l = 0; l < W; ++l) {
     double vc[NS], pc[NP], J[NS * NS], rhs[NS], dv[NS], vt[NS], r[NS], Ft[NS];
