@@ -53,7 +53,7 @@ inline void store_clamped(const double (&v)[NS][W], int i0, const double* floor,
 // flags as doubles so that every select vectorises).
 template <int NS, int NP, int W> struct LockstepLanes {
   double u[NS][W], s0[NS][W], s1[NS][W], p[NP][W];
-  double base[NS][W], v[NS][W], F[NS][W], unorm[W], res[W], its[W], done[W], bad[W], prev[W];
+  double base[NS][W], v[NS][W], F[NS][W], unorm[W], res[W], its[W], done[W], bad[W];
 };
 
 // Lane l of the per-lane arrays x (a state: u or v) and p, as per-cell arrays.

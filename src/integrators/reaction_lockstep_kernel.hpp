@@ -6,18 +6,21 @@
 //   Trapezoidal    F(v) = v - u - dt/2 (R(u) + S0 + R(v) + S1)       = 0
 // started from the better of u and the explicit Euler predictor, full Newton steps
 //   (I - c dt dR/du(v)) dv = -F(v),  v <- v + dv,
-// converged by reaction_kernel.hpp's test (||dv||_inf <= tol (1 + max(||u||_inf, ||v||_inf)) or
-// the contraction estimate from the previous update, newton_converged_mask), but solved for W = 64
+// converged by the first two of reaction_kernel.hpp's tests (||dv||_inf or twice the next update
+// ||A^-1 F(v)||_inf, by the same Cramer inverse, <= tol (1 + max(||u||_inf, ||v||_inf)); the
+// third, the contraction estimate, stops only what has reached the round-off floor above a tol
+// near machine epsilon, whose lanes run to maxit here and go to the per-cell solver with
+// everything else below), but solved for W = 64
 // cells of a row at once, held as structure-of-arrays (one array per species/state over the lanes):
-// the start and each Newton step is one loop over the lanes with no branches - 0/1 masks held
-// as doubles, selects, no early exit per lane - so GCC vectorises it (-fopt-info-vec reports
-// "loop vectorized" for lockstep_start and lockstep_newton; 512-bit vectors where the target
-// has AVX-512), the linear solve is Cramer's rule on the analytic Jacobian (2x2, 3x3), and a
-// converged lane is frozen by the masks (it keeps the iterate at which it converged, as the
-// per-cell solver returns it). Steps repeat until no lane of the chunk is active. A full chunk
-// in which every lane converged (the usual case) is loaded and stored by plain vector copies.
-// A lane that would need anything else - a damped step (the step is large and the full step
-// fails the per-cell solver's Armijo test), a (near-)singular Jacobian (|det| <= 64 eps
+// the start and each Newton step is one loop over the lanes with no branches - 0/1 masks held as
+// doubles, selects, no early exit per lane - so GCC vectorises it (-fopt-info-vec reports "loop
+// vectorized" for lockstep_start and lockstep_newton; 512-bit vectors where the target has
+// AVX-512), the linear solve is Cramer's rule on the analytic Jacobian (2x2, 3x3), and a converged
+// lane is frozen by the masks (it keeps the iterate at which it converged, as the per-cell solver
+// returns it). Steps repeat until no lane of the chunk is active. A full chunk in which every lane
+// converged (the usual case) is loaded and stored by plain vector copies. A lane that would need
+// anything else - a damped step (the step is large and the full step fails the per-cell solver's
+// Armijo test), a (near-)singular Jacobian (|det| <= 64 eps
 // ||A||_inf^N), a non-finite value, or more than maxit iterations - is redone by
 // reaction_cell_of from its inputs, so damping and every failure report are exactly the
 // per-cell solver's. Results agree with the per-cell solver to rounding (Cramer vs. pivoted
@@ -39,9 +42,25 @@ namespace morphogen {
 
 namespace detail {
 
-// x = A^-1 b for N = 2, 3 (row-major A) by Cramer's rule; returns 1.0, or 0.0 when
-// |det| <= 64 eps ||A||_inf^N (numerically singular; x is then unspecified). Branch-free.
-template <int N> inline double cramer_lane(const double* A, const double* b, double* x) {
+// x = det(A) A^-1 b for N = 2, 3 (row-major A): Cramer's numerators.
+template <int N> inline void cramer_numerators(const double* A, const double* b, double* x) {
+  if constexpr (N == 2) {
+    x[0] = b[0] * A[3] - A[1] * b[1];
+    x[1] = A[0] * b[1] - A[2] * b[0];
+  } else {
+    const double c00 = A[4] * A[8] - A[5] * A[7], c01 = A[5] * A[6] - A[3] * A[8],
+                 c02 = A[3] * A[7] - A[4] * A[6];
+    x[0] = c00 * b[0] + (A[2] * A[7] - A[1] * A[8]) * b[1] + (A[1] * A[5] - A[2] * A[4]) * b[2];
+    x[1] = c01 * b[0] + (A[0] * A[8] - A[2] * A[6]) * b[1] + (A[2] * A[3] - A[0] * A[5]) * b[2];
+    x[2] = c02 * b[0] + (A[1] * A[6] - A[0] * A[7]) * b[1] + (A[0] * A[4] - A[1] * A[3]) * b[2];
+  }
+}
+
+// x = A^-1 b for N = 2, 3 (row-major A) by Cramer's rule, *inv_det = 1 / det A; returns 1.0, or
+// 0.0 when |det| <= 64 eps ||A||_inf^N (numerically singular; x is then unspecified).
+// Branch-free.
+template <int N>
+inline double cramer_lane(const double* A, const double* b, double* x, double* inv_det) {
   static_assert(N == 2 || N == 3, "cramer_solve: 2 or 3 unknowns");
   double norm = 0.0;
 #pragma GCC unroll 16
@@ -52,29 +71,27 @@ template <int N> inline double cramer_lane(const double* A, const double* b, dou
       row += std::fabs(A[r * N + c]);
     norm = row > norm ? row : norm;
   }
-  if constexpr (N == 2) {
-    const double det = A[0] * A[3] - A[1] * A[2];
-    const double inv = 1.0 / det;
-    x[0] = (b[0] * A[3] - A[1] * b[1]) * inv;
-    x[1] = (A[0] * b[1] - A[2] * b[0]) * inv;
-    return std::fabs(det) > 64.0 * DBL_EPSILON * norm * norm ? 1.0 : 0.0;
-  } else {
-    const double c00 = A[4] * A[8] - A[5] * A[7], c01 = A[5] * A[6] - A[3] * A[8],
-                 c02 = A[3] * A[7] - A[4] * A[6];
-    const double det = A[0] * c00 + A[1] * c01 + A[2] * c02;
-    const double inv = 1.0 / det;
-    x[0] = (c00 * b[0] + (A[2] * A[7] - A[1] * A[8]) * b[1] + (A[1] * A[5] - A[2] * A[4]) * b[2]) *
-           inv;
-    x[1] = (c01 * b[0] + (A[0] * A[8] - A[2] * A[6]) * b[1] + (A[2] * A[3] - A[0] * A[5]) * b[2]) *
-           inv;
-    x[2] = (c02 * b[0] + (A[1] * A[6] - A[0] * A[7]) * b[1] + (A[0] * A[4] - A[1] * A[3]) * b[2]) *
-           inv;
-    return std::fabs(det) > 64.0 * DBL_EPSILON * norm * norm * norm ? 1.0 : 0.0;
-  }
+  double det;
+  if constexpr (N == 2)
+    det = A[0] * A[3] - A[1] * A[2];
+  else
+    det = A[0] * (A[4] * A[8] - A[5] * A[7]) + A[1] * (A[5] * A[6] - A[3] * A[8]) +
+          A[2] * (A[3] * A[7] - A[4] * A[6]);
+  const double inv = 1.0 / det;
+  *inv_det = inv;
+  cramer_numerators<N>(A, b, x);
+#pragma GCC unroll 16
+  for (int k = 0; k < N; ++k)
+    x[k] *= inv;
+  double bound = 64.0 * DBL_EPSILON * norm;
+  for (int k = 1; k < N; ++k)
+    bound *= norm;
+  return std::fabs(det) > bound ? 1.0 : 0.0;
 }
 
 template <int N> inline bool cramer_solve(const double* A, const double* b, double* x) {
-  return cramer_lane<N>(A, b, x) != 0.0;
+  double inv;
+  return cramer_lane<N>(A, b, x, &inv) != 0.0;
 }
 
 // Start: base, the better of u and the Euler predictor, its residual; lanes with a non-finite
@@ -116,7 +133,6 @@ MG_LANES_WIDE inline void lockstep_start(LockstepLanes<NS, NP, W>& L, double tra
     L.res[l] = res;
     L.unorm[l] = un;
     L.its[l] = 0.0;
-    L.prev[l] = 0.0;
     L.bad[l] = bad;
     L.done[l] = bad == 0.0 && res == 0.0 ? 1.0 : 0.0;
   }
@@ -142,7 +158,8 @@ MG_LANES_WIDE MG_LANES_INLINE void lockstep_newton(LockstepLanes<NS, NP, W>& L, 
       rhs[s] = -L.F[s][l];
       f2 += L.F[s][l] * L.F[s][l];
     }
-    const double regular = cramer_lane<NS>(J, rhs, dv);
+    double inv;
+    const double regular = cramer_lane<NS>(J, rhs, dv, &inv);
 #pragma GCC unroll 16
     for (int s = 0; s < NS; ++s) {
       vt[s] = vc[s] + dv[s];
@@ -167,8 +184,16 @@ MG_LANES_WIDE MG_LANES_INLINE void lockstep_newton(LockstepLanes<NS, NP, W>& L, 
     const double act = (1.0 - L.done[l]) * (1.0 - L.bad[l]);
     const double ok = regular * finite_mask(fin) * (1.0 - far * (1.0 - armijo));
     const double take = act * ok;
-    const double conv = newton_converged_mask(step, L.prev[l], tol * (1.0 + (un > vtn ? un : vtn)));
-    const double res0 = L.res[l], its0 = L.its[l], prev0 = L.prev[l];
+    double ahead[NS], num = 0.0; // A^-1 F(vt) = ahead / det: about the error left in vt
+    cramer_numerators<NS>(J, Ft, ahead);
+#pragma GCC unroll 16
+    for (int s = 0; s < NS; ++s) {
+      const double a = std::fabs(ahead[s]);
+      num = a > num ? a : num;
+    }
+    const double bound = tol * (1.0 + (un > vtn ? un : vtn));
+    const double conv = step <= bound || 2.0 * (num * std::fabs(inv)) <= bound ? 1.0 : 0.0;
+    const double res0 = L.res[l], its0 = L.its[l];
 #pragma GCC unroll 16
     for (int s = 0; s < NS; ++s) {
       const double F0 = -rhs[s];
@@ -177,7 +202,6 @@ MG_LANES_WIDE MG_LANES_INLINE void lockstep_newton(LockstepLanes<NS, NP, W>& L, 
     }
     L.res[l] = take != 0.0 ? rest : res0;
     L.its[l] = take != 0.0 ? it : its0;
-    L.prev[l] = take != 0.0 ? step : prev0;
     L.bad[l] += act * (1.0 - ok);
     L.done[l] += take * conv;
   }
