@@ -95,6 +95,11 @@ const Conditional kConditional[] = {
     {"split_", "-split_newton_tol X, -split_newton_max_it N",
      "per-cell Newton tolerance (default 1e-12, allowed [1e-16, 0.01]) and iteration cap "
      "(default 20, allowed [1, 1000])"},
+    {"split_", "-split_fuse_reaction true|false, -split_fuse_planes true|false",
+     "Strang: merge the reaction half-steps of consecutive steps that nothing observes in between "
+     "(default false); run a reaction substep inside the next diffusion substep's first pass "
+     "where every diffusing species is solved by the tridiagonal method (default true, bitwise "
+     "the same)"},
     {"advect", "-advect a,b",
      "species carried by the velocity: semi-Lagrangian advection after reaction and diffusion "
      "each step, with every integrator (default: none)"},
