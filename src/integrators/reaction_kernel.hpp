@@ -174,11 +174,16 @@ template <int N> inline void lu_apply(const double* A, const int* piv, double* b
 
 // The convergence test of the header comment after a full Newton update of size `step`, the
 // full update before it `prev` (0: none), next = ||A^-1 F(v)||_inf for the new iterate v and the
-// matrix A of that update, and bound = tol * scale; branch-free (the lockstep kernel applies it
-// per lane): step <= bound, or step^2 <= (prev - step) bound, which for prev > 0 is
-// theta / (1 - theta) step <= bound with theta = step / prev < 1, or 2 next <= bound.
+// matrix A of that update, and bound = tol * scale; branch-free (the lockstep kernel applies its
+// first two tests per lane, newton_update_converged_mask): step <= bound, or 2 next <= bound, or
+// step^2 <= (prev - step) bound, which for prev > 0 is theta / (1 - theta) step <= bound with
+// theta = step / prev < 1.
+inline double newton_update_converged_mask(double step, double next, double bound) {
+  return step <= bound || 2.0 * next <= bound ? 1.0 : 0.0;
+}
+
 inline double newton_converged_mask(double step, double prev, double next, double bound) {
-  const double plain = step <= bound || 2.0 * next <= bound ? 1.0 : 0.0;
+  const double plain = newton_update_converged_mask(step, next, bound);
   const double estimate = step * step <= (prev - step) * bound ? 1.0 : 0.0;
   return plain > estimate ? plain : estimate;
 }

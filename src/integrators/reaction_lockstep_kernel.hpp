@@ -192,7 +192,7 @@ MG_LANES_WIDE MG_LANES_INLINE void lockstep_newton(LockstepLanes<NS, NP, W>& L, 
       num = a > num ? a : num;
     }
     const double bound = tol * (1.0 + (un > vtn ? un : vtn));
-    const double conv = step <= bound || 2.0 * (num * std::fabs(inv)) <= bound ? 1.0 : 0.0;
+    const double conv = newton_update_converged_mask(step, num * std::fabs(inv), bound);
     const double res0 = L.res[l], its0 = L.its[l];
 #pragma GCC unroll 16
     for (int s = 0; s < NS; ++s) {
