@@ -360,9 +360,17 @@ void SpectralTransform::reals_done(Vec u, const PlaneView& v, bool store) {
 // stays in L1 than in the state (2-D, 1024^2, 2 ranks: the diffusion substep 1-3 % faster than
 // writing aligned rows in place; the same bits either way). Planes of cosines and sines (no rest
 // axis periodic) are transformed by TrigTransform, rows from and to the state, then the
-// plane's columns (3-D) in the spectrum.
+// plane's columns (3-D) in the spectrum. spec may overlap the plane (a spectrum kept in the
+// state's own memory): the transform then goes through the scratch plane.
 void SpectralTransform::plane_forward(const PlaneView& v, PetscInt j, double* spec) {
   const double* p = v.base + j * v.plane;
+  const PetscInt ns = ncolsS_ * w_;
+  const bool overlap = spec < p + (v.rows - 1) * v.row + v.len && p < spec + ns; // in place
+  if (plans_->trig && overlap) {
+    trig_plane_forward(p, v.row, v.rows, planeS_);
+    std::copy(planeS_, planeS_ + ns, spec);
+    return;
+  }
   if (plans_->trig) return trig_plane_forward(p, v.row, v.rows, spec);
   double* in = const_cast<double*>(p); // forward out-of-place plans preserve their input
   if (!((v.rows == 1 || v.row == v.len) && fftw_alignment_of(in) == 0)) {
@@ -370,18 +378,22 @@ void SpectralTransform::plane_forward(const PlaneView& v, PetscInt j, double* sp
       std::copy(p + r * v.row, p + r * v.row + v.len, planeR_ + r * v.len);
     in = planeR_;
   }
-  double* out = fftw_alignment_of(spec) == 0 ? spec : planeS_;
+  double* out = fftw_alignment_of(spec) == 0 && !overlap ? spec : planeS_;
   if (w_ == 2)
     fftw_execute_dft_r2c(plans_->planeF, in, reinterpret_cast<fftw_complex*>(out));
   else
     fftw_execute_r2r(plans_->planeF, in, out);
-  if (out != spec) std::copy(planeS_, planeS_ + ncolsS_ * w_, spec);
+  if (out != spec) std::copy(planeS_, planeS_ + ns, spec);
 }
 
 void SpectralTransform::plane_backward(double* spec, const PlaneView& v, PetscInt j) {
   const PetscInt ns = ncolsS_ * w_;
   double* p = v.base + j * v.plane;
-  if (plans_->trig) return trig_plane_backward(spec, p, v.row, v.rows);
+  if (plans_->trig) {
+    if (spec < p + (v.rows - 1) * v.row + v.len && p < spec + ns) // in place
+      spec = std::copy(spec, spec + ns, planeS_) - ns;
+    return trig_plane_backward(spec, p, v.row, v.rows);
+  }
   double* in = fftw_alignment_of(spec) == 0 ? spec : std::copy(spec, spec + ns, planeS_) - ns;
   if (w_ == 2)
     fftw_execute_dft_c2r(plans_->planeB, reinterpret_cast<fftw_complex*>(in), planeR_);

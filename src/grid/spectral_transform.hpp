@@ -78,7 +78,8 @@ public:
   PlaneView reals(Vec u, bool fetch);
   void reals_done(Vec u, const PlaneView& v, bool store);
   bool direct() const { return direct_; }
-  void plane_forward(const PlaneView& v, PetscInt j, double* spec);  // spec = T_rest (plane j)
+  // spec = T_rest (plane j); spec and plane j may overlap (spec then replaces the plane).
+  void plane_forward(const PlaneView& v, PetscInt j, double* spec);
   void plane_backward(double* spec, const PlaneView& v, PetscInt j); // spec destroyed
 
 private:

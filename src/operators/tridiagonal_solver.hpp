@@ -31,9 +31,11 @@
 // step_local_group_begin runs several species' down passes in lockstep, plane by plane, with a
 // caller's hook before each plane is first read (the split integrator's merged reaction).
 // Back substitution writes the rows it emits at once to scratch rows (the spectrum's cache
-// lines stay clean), and the down pass prefetches the state's planes three ahead. create()
-// returns null and says why where it does not apply (at most kMaxRanks ranks, S >= 3 planes);
-// the caller then uses the full transform (spectral_solver.hpp) or KSP.
+// lines stay clean), and the down pass prefetches the state's planes three ahead. step_local
+// keeps the spectrum in the local vector's own planes where each plane's stride holds a row
+// (rows_in_state: no separate spectrum in memory; ghost cells under a row saved and restored).
+// create() returns null and says why where it does not apply (at most kMaxRanks ranks, S >= 3
+// planes); the caller then uses the full transform (spectral_solver.hpp) or KSP.
 #pragma once
 
 #include "grid/spectral_transform.hpp"
@@ -63,6 +65,8 @@ public:
   void step_local_begin(Vec ulocal, double c, double theta) override;
   void step_local_end(Vec ulocal) override;
   std::string method() const override;
+  // Whether the last step_local kept its spectrum in the local vector's own planes (tests).
+  bool last_step_in_place() const { return in_place_; }
 
   // One species' substep in a group of solvers on the same grid (step_local_group_begin).
   struct GroupMember {
@@ -112,7 +116,13 @@ private:
   void ends(const PlaneView& out);
   bool spiked(PetscInt i) const { return i < kp_ || i >= m_ - 2 - kq_; } // interior row i
   void emit(PetscInt j, const PlaneView& out) { t_->plane_backward(row(j), out, j); }
-  double* row(PetscInt j) { return t_->spectrum() + j * n_; }
+  double* row(PetscInt j) { return rows_ + j * row_stride_; }
+  void rows_in_spectrum() {
+    rows_ = t_->spectrum();
+    row_stride_ = n_;
+  }
+  bool rows_in_state(Vec ulocal); // step_local: spectral row j in place of owned plane j
+  void restore_ghosts();
   const double* diagonal(PetscInt j) const; // M's diagonal of my row j
 
   const Grid& grid_;
@@ -151,6 +161,13 @@ private:
   std::vector<double> rinv_; // [2][2P][lane]: my rows of the reduced inverse
   std::vector<double> gmine_, gall_;
   MPI_Request gather_req_ = MPI_REQUEST_NULL;
+  // Spectral row j: rows_ + j row_stride_ (the transform's spectrum, or the owned planes of a
+  // local vector, each at least n_ doubles long, in step_local: no separate spectrum in memory).
+  double* rows_ = nullptr;
+  std::ptrdiff_t row_stride_ = 0;
+  std::vector<std::ptrdiff_t> span_ghosts_; // in place: offsets in a row that are ghost cells
+  std::vector<double> ghost_save_;          // and their values, plane by plane
+  bool in_place_ = false;
   PlaneView local_;               // step_local_begin's view of the local vector
   double* local_array_ = nullptr; // and its array (restored by step_local_end)
 };

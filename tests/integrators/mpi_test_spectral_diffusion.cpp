@@ -197,9 +197,9 @@ TEST(SpectralDiffusion, TridiagonalAgreesWithTheFullTransform) {
 }
 
 // The tridiagonal solve in place on a ghosted local vector (what the split integrator uses
-// where the DMDA is split in slabs) equals the solve of the owned cells in a global vector bit
-// for bit and leaves the ghosts alone; 2-D odd and even rows (planes through the scratch plane
-// or not), 3-D, Crank-Nicolson and backward Euler.
+// where the DMDA is split in slabs, its spectrum in the state's own planes) equals the solve of the
+// owned cells in a global vector bit for bit and leaves the ghosts alone; 2-D odd and even rows
+// (planes through the scratch plane or not), 3-D, Crank-Nicolson and backward Euler.
 TEST(SpectralDiffusion, TridiagonalInPlaceOnTheLocalStateEqualsTheGlobalSolve) {
   struct Case {
     const char *n, *L, *stencil, *bc;
@@ -238,6 +238,7 @@ TEST(SpectralDiffusion, TridiagonalInPlaceOnTheLocalStateEqualsTheGlobalSolve) {
     VecRestoreArray(local, &l);
     ts->step(global, 0.35, k.theta);
     ts->step_local(local, 0.35, k.theta);
+    EXPECT_TRUE(all_ranks(ts->last_step_in_place())); // the spectrum in the state's own planes
     VecGetArray(local, &l);
     VecGetArray(global, &g);
     long differ = 0, ghosts_changed = 0, moved = 0;
