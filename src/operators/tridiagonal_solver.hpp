@@ -30,10 +30,10 @@
 // reduced system's allgather of one species overlap the next species' passes (SplitIntegrator);
 // step_local_group_begin runs several species' down passes in lockstep, plane by plane, with a
 // caller's hook before each plane is first read (the split integrator's merged reaction).
-// Back substitution writes the rows it emits at once to scratch rows (the spectrum's cache
-// lines stay clean), and the down pass prefetches the state's planes three ahead. step_local
-// keeps the spectrum in the local vector's own planes where each plane's stride holds a row
-// (rows_in_state: no separate spectrum in memory; ghost cells under a row saved and restored).
+// Back substitution writes the rows it emits at once to scratch rows (the spectrum's rows are
+// then only read on the way up), and the down pass prefetches the state's planes three ahead.
+// step_local keeps the spectrum in the local vector's own planes where each plane's stride holds a
+// row (rows_in_state: no separate spectrum in memory; ghost cells under a row saved and restored).
 // create() returns null and says why where it does not apply (at most kMaxRanks ranks, S >= 3
 // planes); the caller then uses the full transform (spectral_solver.hpp) or KSP.
 #pragma once

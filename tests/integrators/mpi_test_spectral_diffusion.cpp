@@ -208,7 +208,9 @@ TEST(SpectralDiffusion, TridiagonalInPlaceOnTheLocalStateEqualsTheGlobalSolve) {
   for (const Case& k :
        {Case{"8,40", "2,10", "5pt", "periodic", 0.5}, Case{"7,36", "1.75,9", "9pt", "neumann", 1.0},
         Case{"6,5,24", "1.5,1.25,6", "7pt", "periodic,neumann,periodic", 0.5},
-        Case{"5,6,20", "1.25,1.5,5", "27pt", "neumann", 1.0}}) {
+        Case{"5,6,20", "1.25,1.5,5", "27pt", "neumann", 1.0},
+        Case{"9,40", "2.25,10", "9pt", "periodic", 0.5},         // rows of n + 1 entries
+        Case{"6,5,24", "1.5,1.25,6", "7pt", "periodic", 1.0}}) { // ghosts within a row
     SCOPED_TRACE(std::string(k.n) + " " + k.stencil + " " + k.bc);
     OptionList o = diffusion_case(k.n, k.L, "1 +- 20%", "spectral");
     o.insert(o.end(), {{"stencil", k.stencil}, {"grid_bc", k.bc}});
