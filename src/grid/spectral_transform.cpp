@@ -354,6 +354,14 @@ void SpectralTransform::reals_done(Vec u, const PlaneView& v, bool store) {
   }
 }
 
+// Whether a spectrum of n entries at spec shares memory with plane p of v (addresses compared as
+// integers: the two may point into different arrays).
+static bool overlaps(const double* spec, PetscInt n, const double* p, const PlaneView& v) {
+  const auto a = reinterpret_cast<std::uintptr_t>(spec), b = reinterpret_cast<std::uintptr_t>(p);
+  const auto plane_bytes = sizeof(double) * static_cast<size_t>((v.rows - 1) * v.row + v.len);
+  return a < b + plane_bytes && b < a + sizeof(double) * static_cast<size_t>(n);
+}
+
 // The plane plans were made for contiguous FFTW-aligned planes. The forward transform reads a
 // plane in place where it is one (the state's rows: Grid::create_local aligns them); any other
 // plane goes through the scratch plane, and so does the spectrum where it overlaps the plane
@@ -364,24 +372,15 @@ void SpectralTransform::reals_done(Vec u, const PlaneView& v, bool store) {
 // axis periodic) are transformed by TrigTransform, rows from and to the state, then the
 // plane's columns (3-D) in the spectrum (first copied to the scratch plane where it overlaps the
 // plane the rows go to).
-// Whether a spectrum of n entries at spec shares memory with plane p of v (addresses compared as
-// integers: the two may point into different arrays).
-static bool overlaps(const double* spec, PetscInt n, const double* p, const PlaneView& v) {
-  const auto a = reinterpret_cast<std::uintptr_t>(spec), b = reinterpret_cast<std::uintptr_t>(p);
-  const auto plane_bytes = sizeof(double) * static_cast<size_t>((v.rows - 1) * v.row + v.len);
-  return a < b + plane_bytes && b < a + sizeof(double) * static_cast<size_t>(n);
-}
-
 void SpectralTransform::plane_forward(const PlaneView& v, PetscInt j, double* spec) {
   const double* p = v.base + j * v.plane;
   const PetscInt ns = ncolsS_ * w_;
   const bool overlap = overlaps(spec, ns, p, v); // a spectrum in place of the plane
-  if (plans_->trig && overlap) {
-    trig_plane_forward(p, v.row, v.rows, planeS_);
-    std::copy(planeS_, planeS_ + ns, spec);
+  if (plans_->trig) {
+    trig_plane_forward(p, v.row, v.rows, overlap ? planeS_ : spec);
+    if (overlap) std::copy(planeS_, planeS_ + ns, spec);
     return;
   }
-  if (plans_->trig) return trig_plane_forward(p, v.row, v.rows, spec);
   double* in = const_cast<double*>(p); // forward out-of-place plans preserve their input
   if (!((v.rows == 1 || v.row == v.len) && fftw_alignment_of(in) == 0)) {
     for (PetscInt r = 0; r < v.rows; ++r)

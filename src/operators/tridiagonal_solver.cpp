@@ -552,7 +552,7 @@ bool TridiagonalSolver::rows_in_state(Vec ulocal) {
 
 // The ghost cells the rows covered, back (after the last row went back to the state).
 void TridiagonalSolver::restore_ghosts() {
-  if (rows_ == t_->spectrum()) return;
+  if (!in_place_) return;
   const double* saved = ghost_save_.data();
   for (PetscInt j = 0; j < m_; ++j)
     for (std::ptrdiff_t o : span_ghosts_)
