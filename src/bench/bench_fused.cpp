@@ -1,6 +1,7 @@
 #include "bench/bench_fused.hpp"
 
 #include "app/simulation.hpp"
+#include "bench/bench_row_kernel.hpp"
 #include "bench/bench_scoped_options.hpp"
 #include "core/user_error.hpp"
 
@@ -70,6 +71,7 @@ void bench_fused(MPI_Comm comm, Options& opt, const FusedSettings& fs, double ro
   const auto& stencil = fs.stencil;
   const PetscInt steps = fs.steps;
   const PetscInt kmax = *std::max_element(depth.begin(), depth.end());
+  print_row_kernel_bounds(comm, stencil, roof);
   for (const auto& n : fs.ns) {
     const std::vector<std::pair<std::string, std::string>> o = {
         {"-model", "gray_scott"},

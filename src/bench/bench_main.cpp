@@ -12,8 +12,9 @@
 // explicit vs split (target >= 4x faster, same pattern). Runs on any number of ranks (aggregate
 // figures). Before all that (-bench_output_n, issue 13 parts 3-4, bench/bench_output.hpp): the
 // setup ns per cell, the PNG time and the peak memory per cell at 4096^2. Last line:
-// Then (-bench_fuse_steps, bench/bench_fused.hpp): fused explicit steps (temporal blocking) at
-// 2048^2 and 4096^2 against one step per pass and the roofline. Last line:
+// Then (-bench_fuse_steps, bench/bench_fused.hpp): the row kernel alone with its rows in cache
+// and the bounds it sets (bench/bench_row_kernel.hpp), fused explicit steps (temporal blocking)
+// at 2048^2 and 4096^2 against one step per pass and the roofline. Last line:
 //   roofline_fraction=<2-D fraction>
 #include "app/pattern_summary.hpp"
 #include "app/simulation.hpp"

@@ -1,0 +1,27 @@
+// The explicit row kernel alone (issue 13 part 2, the arithmetic ceiling): the fused Gray-Scott
+// row kernel of a 2-D stencil (5pt or 9pt, h = 1) swept over rows of `n` cells that stay in the
+// per-core L1/L2 caches, on every rank at once, in each compile (256-bit and 512-bit vectors).
+//   ns per cell = best over reps of (slowest rank's seconds) / (calls * n)
+//   ceiling     = ranks / (least ns per cell)   [cell-updates per second]
+// Fused passes redo the same arithmetic per step, so the ceiling bounds them; a single step out
+// of cache whose arithmetic and memory traffic do not overlap takes the sum of both times,
+//   serial bound = 1 / (1 / ceiling + 1 / roofline).
+#pragma once
+
+#include <mpi.h>
+
+#include <string>
+
+namespace morphogen {
+
+struct RowKernelRate {
+  double ns_per_cell[2] = {0, 0}; // [wide]: 256-bit, 512-bit compile
+  double ceiling = 0;             // cell-updates per second on all ranks, faster compile
+};
+
+RowKernelRate time_row_kernel(MPI_Comm comm, const std::string& stencil, int n);
+
+// Prints the kernel's rates, the ceiling and the serial bound against `roof` (cell-updates/s).
+void print_row_kernel_bounds(MPI_Comm comm, const std::string& stencil, double roof);
+
+} // namespace morphogen
