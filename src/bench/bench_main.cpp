@@ -21,6 +21,7 @@
 #include "bench/bench_fluids.hpp"
 #include "bench/bench_fused.hpp"
 #include "bench/bench_output.hpp"
+#include "bench/bench_row_kernel.hpp"
 #include "bench/bench_scaling.hpp"
 #include "bench/bench_scoped_options.hpp"
 #include "bench/bench_timing.hpp"
@@ -559,6 +560,8 @@ int run(MPI_Comm comm) {
   };
   PetscPrintf(comm, "explicit_3d_target grid=%s fraction=%.3f %s\n", name3.c_str(), r3.cups / roof,
               target3(r3.cups).c_str());
+  for (const char* st : {"7pt", "19pt", "27pt"}) // the kernels alone and the bounds they set
+    print_row_kernel_bounds(comm, st, 3, roof);
   // The isotropic 3-D box stencils: the same bytes per update, 19 or 27 taps per species.
   for (const char* st : {"19pt", "27pt"}) {
     const Result rb =

@@ -1,6 +1,7 @@
 // The explicit row kernel alone (issue 13 part 2, the arithmetic ceiling): the fused Gray-Scott
-// row kernel of a 2-D stencil (5pt or 9pt, h = 1) swept over rows of `n` cells that stay in the
-// per-core L1/L2 caches, on every rank at once, in each compile (256-bit and 512-bit vectors).
+// row kernel of a stencil (2-D 5pt, 9pt; 3-D 7pt, 19pt, 27pt, the box stencils in their
+// weight-class form as the explicit integrator runs them; h = 1) swept over rows of `n` cells
+// that stay in the per-core caches, on every rank at once, in each compile (256-bit, 512-bit).
 //   ns per cell = best over reps of (slowest rank's seconds) / (calls * n)
 //   ceiling     = ranks / (least ns per cell)   [cell-updates per second]
 // Fused passes redo the same arithmetic per step, so the ceiling bounds them; a single step out
@@ -19,9 +20,9 @@ struct RowKernelRate {
   double ceiling = 0;             // cell-updates per second on all ranks, faster compile
 };
 
-RowKernelRate time_row_kernel(MPI_Comm comm, const std::string& stencil, int n);
+RowKernelRate time_row_kernel(MPI_Comm comm, const std::string& stencil, int dim, int n);
 
 // Prints the kernel's rates, the ceiling and the serial bound against `roof` (cell-updates/s).
-void print_row_kernel_bounds(MPI_Comm comm, const std::string& stencil, double roof);
+void print_row_kernel_bounds(MPI_Comm comm, const std::string& stencil, int dim, double roof);
 
 } // namespace morphogen
