@@ -88,8 +88,8 @@ def test_fused_section_keeps_its_depths(tmp_path):
     m = re.search(r"^explicit_row_kernel model=gray_scott stencil=9pt row=512 "
                   r"ns_per_cell_256bit=(\S+) ns_per_cell_512bit=(\S+) ", p.stdout, re.M)
     assert m and float(m.group(1)) > 0 and float(m.group(2)) > 0, p.stdout
-    ceil = re.search(r"^explicit_ceiling cell_updates_per_s=(\S+) ", p.stdout, re.M)
-    serial = re.search(r"^explicit_serial_bound cell_updates_per_s=(\S+) ", p.stdout, re.M)
+    ceil = re.search(r"^explicit_ceiling stencil=9pt cell_updates_per_s=(\S+) ", p.stdout, re.M)
+    serial = re.search(r"^explicit_serial_bound stencil=9pt cell_updates_per_s=(\S+) ", p.stdout, re.M)
     roof = re.search(r"^roofline_cell_updates_per_s=(\S+)", p.stdout, re.M)
     assert ceil and serial and roof, p.stdout
     c, s, r = float(ceil.group(1)), float(serial.group(1)), float(roof.group(1))
