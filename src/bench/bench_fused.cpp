@@ -1,7 +1,7 @@
 #include "bench/bench_fused.hpp"
 
 #include "app/simulation.hpp"
-#include "bench/bench_row_kernel.hpp"
+#include "bench/bench_kernel_rate.hpp"
 #include "bench/bench_scoped_options.hpp"
 #include "core/user_error.hpp"
 

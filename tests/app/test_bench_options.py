@@ -84,7 +84,7 @@ def test_fused_section_keeps_its_depths(tmp_path):
                "-explicit_fuse_steps", "2"], tmp_path, timeout=120)
     assert p.returncode == 0, p.stderr
     assert re.search(r"^explicit_fused grid=64x64 stencil=9pt k=4 ", p.stdout, re.M), p.stdout
-    # The kernel-alone rates and the bounds they give (bench/bench_row_kernel.hpp).
+    # The kernel-alone rates and the bounds they give (bench/bench_kernel_rate.hpp).
     m = re.search(r"^explicit_row_kernel model=gray_scott stencil=9pt row=512 "
                   r"ns_per_cell_256bit=(\S+) ns_per_cell_512bit=(\S+) ", p.stdout, re.M)
     assert m and float(m.group(1)) > 0 and float(m.group(2)) > 0, p.stdout

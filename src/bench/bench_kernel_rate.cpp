@@ -1,4 +1,4 @@
-#include "bench/bench_row_kernel.hpp"
+#include "bench/bench_kernel_rate.hpp"
 
 #include "grid/stencil.hpp"
 #include "integrators/kernel_choice.hpp"
