@@ -664,8 +664,8 @@ void Simulation::read_fuse(Options& opt) {
   integrator_->set_fuse_steps(static_cast<int>(k));
   integrator_->set_fuse_tile(opt.integer(
       "explicit_fuse_tile", 0, 0, 1 << 30,
-      "owned columns per tile of a fused pass (0: automatic, the widest tile whose rows of the k "
-      "steps stay within 1 MiB, half a typical L2 cache); the same results for any width"));
+      "owned columns per tile of a fused pass (0: automatic, the widest tile whose rows of the "
+      "pass's steps stay within 1 MiB, half a typical L2 cache); the same results for any width"));
   const std::string in_place = opt.choice(
       "explicit_in_place", "auto", {"auto", "yes", "no"},
       "fast path (2-D and 3-D): update the state in place, with no second state set (8 bytes per "

@@ -79,12 +79,14 @@ FusedSweep::InputRow FusedSweep::input_row(const std::vector<const double*>& in,
   return {row, own - W};
 }
 
-// Columns per tile: the given width, else the widest whose ring rows (ring_ rows of `depth`
-// levels and ns_ species, its columns plus the 2W halo) stay within kTileBytes.
-PetscInt FusedSweep::tile_width() const {
+// Columns per tile of a pass of n steps: the given width, else the widest whose ring rows
+// (ring_ rows of the n levels the pass uses and ns_ species, its columns plus the 2 n r halo)
+// stay within kTileBytes. A pass shorter than the depth the sweep was built for gets wider
+// tiles (less halo recomputed); the results do not depend on the width.
+PetscInt FusedSweep::tile_width(int n) const {
   if (tile_ > 0) return tile_;
-  const double per_column = 8.0 * static_cast<double>(ring_ * depth_ * ns_);
-  const PetscInt fit = static_cast<PetscInt>(kTileBytes / per_column) - 2 * frame_.width();
+  const double per_column = 8.0 * static_cast<double>(ring_ * n * ns_);
+  const PetscInt fit = static_cast<PetscInt>(kTileBytes / per_column) - 2 * n * r_;
   return std::max<PetscInt>(kInPlaceMin, fit);
 }
 
@@ -99,7 +101,8 @@ void FusedSweep::run(const std::vector<const double*>& in, const std::vector<dou
   }
   LogScope log_scope(log_events().sweep);
   const PetscInt W = frame_.width(), mx = grid_.owned().m[0];
-  const PetscInt tiles = std::max<PetscInt>(1, (mx + tile_width() - 1) / tile_width());
+  const PetscInt width = tile_width(n);
+  const PetscInt tiles = std::max<PetscInt>(1, (mx + width - 1) / width);
   for (PetscInt t = 0; t < tiles; ++t)
     sweep_tile(in, out, n, row, fn, W + t * mx / tiles, W + (t + 1) * mx / tiles);
 }

@@ -61,7 +61,7 @@ private:
   static constexpr PetscInt kInPlaceMin = 512;
   InputRow input_row(const std::vector<const double*>& in, int s, PetscInt jw) const;
   static constexpr double kTileBytes = 1024.0 * 1024; // ring rows of one tile: half an L2
-  PetscInt tile_width() const;
+  PetscInt tile_width(int n) const;                   // owned columns per tile of a pass of n steps
   void sweep_tile(const std::vector<const double*>& in, const std::vector<double*>& out, int n,
                   ExplicitRow row, RowFn fn, PetscInt t0, PetscInt t1) const;
 
