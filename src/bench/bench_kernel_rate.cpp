@@ -19,12 +19,11 @@ namespace {
 // species (row stride n + 16, plane stride 3 rows) and two output rows; values near the
 // Gray-Scott spot state so no cell overflows over repeated calls.
 struct KernelRows {
-  int n;
   long stride;
   std::vector<double> in, out;
   std::vector<const double*> src;
   double* dst[2];
-  explicit KernelRows(int cells) : n(cells), stride(cells + 16) {
+  explicit KernelRows(int cells) : stride(cells + 16) {
     in.resize(static_cast<size_t>(18 * stride));
     out.resize(static_cast<size_t>(2 * stride));
     for (size_t i = 0; i < in.size(); ++i)
