@@ -31,6 +31,7 @@
 #pragma once
 
 #include "fields/clamp_kernel.hpp"
+#include "integrators/box_row_kernel.hpp"
 
 #include <cmath>
 
@@ -57,48 +58,15 @@ struct ExplicitRow {
   long src_stride = 0, dst_stride = 0;
 };
 
-// The two x-profiles of explicit_row_box_classes for x = x0 .. x0 + len - 1 of one species'
-// 9 rows in class order (w: centre, face, edge, corner weight), A being the centre row:
-//   B = (f1 + f2) + (f3 + f4)        (the 4 face rows)
-//   C = (k1 + k2) + (k3 + k4)        (the 4 corner rows)
-//   q(x) = (w_c A + w_f B) + w_e C   (the taps at dx = 0)
-//   p(x) = (w_f A + w_e B) + w_k C   (the taps at dx = -1, +1; w_k C left out if !Corners)
-// (each sum of products a chain of std::fma from the left)
-template <bool Corners, bool Wide = false>
-inline void box_row_profiles(const double* const* rows, const double* w, int x0, int len,
-                             double* __restrict__ p, double* __restrict__ q) {
-  const double* __restrict__ c0 = rows[0] + x0;
-  const double* __restrict__ f1 = rows[1] + x0;
-  const double* __restrict__ f2 = rows[2] + x0;
-  const double* __restrict__ f3 = rows[3] + x0;
-  const double* __restrict__ f4 = rows[4] + x0;
-  const double* __restrict__ k1 = rows[5] + x0;
-  const double* __restrict__ k2 = rows[6] + x0;
-  const double* __restrict__ k3 = rows[7] + x0;
-  const double* __restrict__ k4 = rows[8] + x0;
-  const double wc = w[0], wf = w[1], we = w[2], wk = w[3];
-#pragma GCC ivdep
-  for (int x = 0; x < len; ++x) {
-    const double A = c0[x];
-    const double B = (f1[x] + f2[x]) + (f3[x] + f4[x]);
-    const double C = (k1[x] + k2[x]) + (k3[x] + k4[x]);
-    q[x] = std::fma(we, C, std::fma(wf, B, wc * A));
-    if constexpr (Corners)
-      p[x] = std::fma(wk, C, std::fma(we, B, wf * A));
-    else
-      p[x] = std::fma(we, B, wf * A);
-  }
-}
-
 // The 9-row box stencils by weight class (19pt, 27pt; ExplicitRow::wclass set), rows in class
 // order: src[s*9] the centre row, src[s*9 + 1..4] the face rows, src[s*9 + 5..8] the corner
-// rows. Per chunk of up to kBoxChunk cells, first the profiles p and q of box_row_profiles at
-// x = i-1 .. i+1 into stack buffers, with the class weights scaled by dt D_s, then per cell
-//   out_s = max( fma(dt, R_s, u_s) + (q(i) + (p(i-1) + p(i+1))),  floor_s ).
-// Per cell and species: 9 loads, 6 adds and 4-6 multiply-adds for the profiles, 3 loads and
-// 2 adds for the taps, instead of 27 loads and 27 multiply-adds. Each value is one fixed
-// expression of the cell's neighbours, so neither the chunks nor the rank decomposition change
-// a bit.
+// rows. Per chunk of up to kBoxChunk cells, first d of box_row_diffusion (box_row_kernel.hpp:
+// lane shifts, no loads at x -+ 1) into a stack buffer, with the class weights scaled by dt D_s,
+// then per cell
+//   out_s = max( fma(dt, R_s, u_s) + d_s(i),  floor_s ).
+// Per cell and species: 9 loads, 6 adds and 4-6 multiply-adds for the profiles, 2 adds for
+// the taps, instead of 27 loads and 27 multiply-adds. Each value is one fixed expression of the
+// cell's neighbours, so neither the chunks nor the rank decomposition change a bit.
 constexpr int kBoxChunk = 128;
 
 // True when some species has a finite floor (the max of the update is needed).
@@ -131,11 +99,11 @@ inline void explicit_row_box_classes(const ExplicitRow& a) {
       pc[q] = a.pconst[q];
   }
   const int n = a.n;
-  double pbuf[NS][kBoxChunk + 2], qbuf[NS][kBoxChunk + 2]; // at x = i0 - 1 .. i0 + m
+  alignas(64) double dbuf[NS][kBoxChunk];
   for (int i0 = 0; i0 < n; i0 += kBoxChunk) {
     const int m = n - i0 < kBoxChunk ? n - i0 : kBoxChunk;
     for (int s = 0; s < NS; ++s)
-      box_row_profiles<Corners, Wide>(a.src + s * 9, wc[s], i0 - 1, m + 2, pbuf[s], qbuf[s]);
+      box_row_diffusion<Corners, Wide>(a.src + s * 9, wc[s], i0, m, n, dbuf[s]);
 #pragma GCC ivdep
     for (int x = 0; x < m; ++x) {
       const int i = i0 + x;
@@ -150,8 +118,7 @@ inline void explicit_row_box_classes(const ExplicitRow& a) {
         u[s] = src[s][i];
       M::rates(u, p, r);
       for (int s = 0; s < NS; ++s) {
-        const double v =
-            std::fma(dt, r[s], u[s]) + (qbuf[s][x + 1] + (pbuf[s][x] + pbuf[s][x + 2]));
+        const double v = std::fma(dt, r[s], u[s]) + dbuf[s][x];
         dst[s][i] = Clamp ? clamp_to_floor(v, floor[s]) : v;
       }
     }

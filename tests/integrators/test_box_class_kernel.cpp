@@ -161,3 +161,36 @@ TEST(BoxClassKernel, SameBitsWhateverPartOfTheRowACallCovers) {
     }
   }
 }
+
+// box_row_diffusion (lane shifts on GCC, blocks of 4 or 8 lanes with an overlapping last block)
+// against box_row_diffusion_cells (three profiles per cell, the same expressions): the same
+// bits for every length, start and read limit xmax (tight: x0 + len; loose: the row's end).
+template <bool Corners, bool Wide> void expect_same_diffusion(const Block& b, const BoxRows& st) {
+  const double* rows[9];
+  for (int r = 0; r < 9; ++r) {
+    const int q = st.classes.perm[r];
+    rows[r] = b.u[1].data() + b.idx(0, st.rows.off[q][0], st.rows.off[q][1]);
+  }
+  const double* w = st.classes.w.data();
+  std::vector<double> vec(kN), ref(kN);
+  for (int x0 : {0, 1, 5, 64})
+    for (int len = 1; x0 + len <= kN && len <= 70; ++len)
+      for (int xmax : {x0 + len, kN}) {
+        box_row_diffusion<Corners, Wide>(rows, w, x0, len, xmax, vec.data());
+        box_row_diffusion_cells<Corners>(rows, w, x0, len, ref.data());
+        for (int t = 0; t < len; ++t)
+          ASSERT_EQ(vec[t], ref[t]) << "x0 " << x0 << " len " << len << " xmax " << xmax << " t "
+                                    << t << " wide " << Wide << " corners " << Corners;
+      }
+}
+
+TEST(BoxClassKernel, LaneShiftsGiveTheBitsOfTheCellByCellProfiles) {
+  const Block b(wave);
+  for (const char* name : {"19pt", "27pt"}) {
+    const BoxRows st(name, b.h);
+    expect_same_diffusion<true, false>(b, st);
+    expect_same_diffusion<true, true>(b, st);
+    expect_same_diffusion<false, false>(b, st);
+    expect_same_diffusion<false, true>(b, st);
+  }
+}
