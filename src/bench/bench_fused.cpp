@@ -71,7 +71,7 @@ void bench_fused(MPI_Comm comm, Options& opt, const FusedSettings& fs, double ro
   const auto& stencil = fs.stencil;
   const PetscInt steps = fs.steps;
   const PetscInt kmax = *std::max_element(depth.begin(), depth.end());
-  print_row_kernel_bounds(comm, stencil, 2, roof);
+  print_row_kernel_bounds(comm, stencil, 2, roof, 512); // 2 x 3 rows of 4 KiB: in L1
   for (const auto& n : fs.ns) {
     const std::vector<std::pair<std::string, std::string>> o = {
         {"-model", "gray_scott"},

@@ -97,8 +97,8 @@ RowKernelRate time_row_kernel(MPI_Comm comm, const std::string& stencil, int dim
   return r;
 }
 
-void print_row_kernel_bounds(MPI_Comm comm, const std::string& stencil, int dim, double roof) {
-  const int n = 512; // 2 species x 9 rows x 4 KiB at most, 8 KiB out: in L1/L2
+void print_row_kernel_bounds(MPI_Comm comm, const std::string& stencil, int dim, double roof,
+                             int n) {
   const RowKernelRate r = time_row_kernel(comm, stencil, dim, n);
   const double serial = 1.0 / (1.0 / r.ceiling + 1.0 / roof);
   const char* tag = dim == 3 ? "explicit_3d" : "explicit";

@@ -22,7 +22,9 @@ struct RowKernelRate {
 
 RowKernelRate time_row_kernel(MPI_Comm comm, const std::string& stencil, int dim, int n);
 
-// Prints the kernel's rates, the ceiling and the serial bound against `roof` (cell-updates/s).
-void print_row_kernel_bounds(MPI_Comm comm, const std::string& stencil, int dim, double roof);
+// Prints the kernel's rates on rows of n cells, the ceiling and the serial bound against `roof`
+// (cell-updates/s).
+void print_row_kernel_bounds(MPI_Comm comm, const std::string& stencil, int dim, double roof,
+                             int n);
 
 } // namespace morphogen

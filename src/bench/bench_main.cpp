@@ -560,8 +560,10 @@ int run(MPI_Comm comm) {
   };
   PetscPrintf(comm, "explicit_3d_target grid=%s fraction=%.3f %s\n", name3.c_str(), r3.cups / roof,
               target3(r3.cups).c_str());
-  for (const char* st : {"7pt", "19pt", "27pt"}) // the kernels alone and the bounds they set
-    print_row_kernel_bounds(comm, st, 3, roof);
+  // The kernels alone and the bounds they set, on rows of the grid's side (at most 512 cells:
+  // 2 species x 9 rows of 4 KiB, which at 512 already exceed a 48 KiB L1).
+  for (const char* st : {"7pt", "19pt", "27pt"})
+    print_row_kernel_bounds(comm, st, 3, roof, static_cast<int>(std::min<PetscInt>(n3, 512)));
   // The isotropic 3-D box stencils: the same bytes per update, 19 or 27 taps per species.
   for (const char* st : {"19pt", "27pt"}) {
     const Result rb =
