@@ -3,6 +3,10 @@
 #pragma once
 
 #include <cmath>
+#if defined(__GNUC__) && !defined(__clang__) && !defined(__CUDACC__) &&                            \
+    (defined(__FMA__) || defined(__AVX512F__))
+#include <immintrin.h>
+#endif
 
 namespace morphogen {
 
@@ -70,7 +74,15 @@ template <int L> struct BoxLanes {
       v[l] = a;
     return v;
   }
+  // std::fma per lane: one vector instruction where the target has it (GCC does not always
+  // turn the lane loop into one).
   static V fma(V a, V b, V c) {
+#if defined(__AVX512F__)
+    if constexpr (L == 8) return _mm512_fmadd_pd(a, b, c);
+#endif
+#if defined(__FMA__)
+    if constexpr (L == 4) return _mm256_fmadd_pd(a, b, c);
+#endif
     V r;
     for (int l = 0; l < L; ++l)
       r[l] = std::fma(a[l], b[l], c[l]);
