@@ -23,7 +23,7 @@ struct AxisLayout {
 
 } // namespace
 
-Halo::Halo(const Grid& grid) : grid_(grid) {
+Halo::Halo(const Grid& grid, bool x_wrap) : grid_(grid) {
   DM dm = grid.dm();
   const GridSpec& g = grid.spec();
   PetscInt P[3];
@@ -48,7 +48,7 @@ Halo::Halo(const Grid& grid) : grid_(grid) {
   for (PetscInt k = gb.s[2]; k < gb.s[2] + gb.m[2]; ++k)
     for (PetscInt j = gb.s[1]; j < gb.s[1] + gb.m[1]; ++j)
       for (PetscInt i = gb.s[0]; i < gb.s[0] + gb.m[0]; ++i) {
-        if (ob.contains(i, j, k)) continue;
+        if (ob.contains(i, j, k) || (!x_wrap && (i < 0 || i >= g.n[0]))) continue;
         PetscInt c[3] = {i, j, k};
         bool inside = true;
         for (int d = 0; d < 3 && inside; ++d) {

@@ -23,7 +23,10 @@ struct FaceValues {
 
 class Halo {
 public:
-  explicit Halo(const Grid& grid);
+  // x_wrap = false leaves out every ghost outside the domain in x (the periodic x wrap and the
+  // corners beyond it), for a caller that fills the x ghosts it reads itself (the explicit
+  // sweep of a star stencil: integrators/explicit_integrator.hpp).
+  explicit Halo(const Grid& grid, bool x_wrap = true);
 
   // Start / finish the exchange of inter-rank and periodic ghosts of `a` (ghosted local array).
   void begin(double* a) const;

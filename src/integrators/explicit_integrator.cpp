@@ -30,6 +30,10 @@ ExplicitIntegrator::ExplicitIntegrator(const Grid& grid, const Halo& halo, RowFn
   ring_n_ = static_cast<size_t>(grid.owned().m[0]);
   if (params_.any_field())
     params_.expand_scalars(static_cast<size_t>(grid.owned().m[0]), const_rows_);
+  const GridSpec& g = grid.spec();
+  if (!rows_.box && g.bc[0] == Boundary::Periodic && g.stencil_width == 1 &&
+      grid.ownership_ranges()[0].size() == 1)
+    x_halo_ = std::make_unique<Halo>(grid, false);
 }
 
 double ExplicitIntegrator::stable_dt(const Stencil& stencil, const std::vector<double>& D) {
@@ -47,16 +51,20 @@ void ExplicitIntegrator::use_operators(std::vector<const DiffusionOperator*> ops
 }
 
 void ExplicitIntegrator::update_ghosts(std::vector<VecH>& u) const {
+  exchange(u, halo_);
+}
+
+void ExplicitIntegrator::exchange(std::vector<VecH>& u, const Halo& halo) const {
   LogScope log_scope(log_events().halo);
   std::vector<PetscScalar*>& a = tab_.in;
   a.assign(static_cast<size_t>(ns_), nullptr);
   for (int s = 0; s < ns_; ++s)
     MG_PETSC(VecGetArray(u[s], &a[s]));
   for (int s = 0; s < ns_; ++s)
-    halo_.begin(a[s]);
+    halo.begin(a[s]);
   for (int s = 0; s < ns_; ++s) {
-    halo_.end(a[s]);
-    halo_.fill_boundaries(a[s], dirichlet_ ? &(*dirichlet_)[s] : nullptr);
+    halo.end(a[s]);
+    halo.fill_boundaries(a[s], dirichlet_ ? &(*dirichlet_)[s] : nullptr);
   }
   for (int s = 0; s < ns_; ++s)
     MG_PETSC(VecRestoreArray(u[s], &a[s]));
@@ -139,7 +147,7 @@ void ExplicitIntegrator::step(std::vector<VecH>& u, double t, double dt, PetscIn
   // Coefficients and Dirichlet values using t: at the step's start (before the ghosts take the
   // boundary values).
   if (terms_) terms_->set_time(t);
-  update_ghosts(u);
+  exchange(u, fills_x() ? *x_halo_ : halo_);
   if (terms_) terms_->refresh(u); // solution-dependent diffusion: coefficients of u^n
   if (others_.empty()) {
     sweep(u, in_place() ? nullptr : &work_, dt);
@@ -263,6 +271,17 @@ PetscInt ExplicitIntegrator::prefetch_offset(const std::vector<PetscInt>& delta)
   return *std::max_element(delta.begin(), delta.end()) + kPrefetchRows * grid_.ghosted().m[0];
 }
 
+void ExplicitIntegrator::wrap_x(const std::vector<PetscScalar*>& u, PetscInt c, int rows,
+                                PetscInt gx) const {
+  const PetscInt n = grid_.owned().m[0];
+  for (int s = 0; s < ns_; ++s)
+    for (int r = 0; r < rows; ++r) {
+      double* p = u[s] + c + r * gx;
+      p[-1] = p[n - 1];
+      p[n] = p[0];
+    }
+}
+
 // In-place sweeps (header comment): the old row t is last read by row t + R_z bh + R_y.
 int ExplicitIntegrator::reach(int axis) const {
   int r = 0;
@@ -320,6 +339,7 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
   const int np = static_cast<int>(params_.scalar.size());
   const bool field_mode = params_.any_field();
   const bool in_place = work == nullptr; // in_place()
+  const bool fill_x = fills_x();
   if (in_place) ring_.resize(static_cast<size_t>(ns_) * ring_depth_ * ring_n_);
   SweepTables& tb = tab_;
   auto& in = tb.in;
@@ -393,6 +413,7 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
           for (int q = 0; q < np; ++q)
             prow[q] = pf[q] ? pf[q] + o : const_rows_[q].data();
         }
+        if (fill_x) wrap_x(in, c, row.rows, gx);
         if (pf_off >= 0 && c + pf_off <= pf_end)
           for (int s = 0; s < ns_; ++s)
             prefetch_doubles(in[s] + c + pf_off, ob.m[0]);

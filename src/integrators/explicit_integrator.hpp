@@ -4,7 +4,9 @@
 //
 // The driver owns communication: halo update of every species (begin all, end all, then the
 // physical boundaries), then one pass over the owned box calling the model's fused row kernel
-// (explicit_kernel.hpp) for each grid row. State lives in ghosted local Vecs. The fast path
+// (explicit_kernel.hpp) for each grid row. With a star stencil and x periodic and unsplit, the
+// sweep sets each row's two x ghosts itself just before the row's kernel (fills_x()), and the
+// halo update leaves them out. State lives in ghosted local Vecs. The fast path
 // updates them in place where a rank's state is large (set_in_place). In 3-D the box is swept in
 // blocks of bh y rows (all planes of a block, then the next block: L2 reuse of the three planes
 // a row reads), in 2-D as one block; within a block rows go in the order t = (k - k0) bh + j - jb,
@@ -151,8 +153,20 @@ private:
   void add_other_terms(std::vector<VecH>& u, double t, double dt);
   void step_general(std::vector<VecH>& u, std::vector<VecH>& work, double dt) const;
 
+  // The halo update of a step: without the x ghosts where the sweep fills them (fills_x()).
+  void exchange(std::vector<VecH>& u, const Halo& halo) const;
+  // Whether the sweep fills the periodic x ghosts of each row it computes (the centre row: in
+  // cache then), and the step's halo update leaves them out (x_halo_): a star stencil (no
+  // other row's x ghosts are read), x periodic and not split between ranks, one ghost layer,
+  // the fast path without other terms. Each row's two x ghosts lie in their own cache lines,
+  // which the halo update would fetch from memory once more.
+  bool fills_x() const { return x_halo_ && ops_.empty() && others_.empty(); }
+  // p[-1] = p[n - 1], p[n] = p[0] for `rows` rows of every species from cell c (stride gx).
+  void wrap_x(const std::vector<PetscScalar*>& u, PetscInt c, int rows, PetscInt gx) const;
+
   const Grid& grid_;
   const Halo& halo_;
+  std::unique_ptr<Halo> x_halo_; // halo_ without the x ghosts (null where !fills_x())
   RowFn row_fn_;
   int ns_;
   Stencil stencil_;
