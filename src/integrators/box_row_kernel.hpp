@@ -18,7 +18,7 @@ namespace morphogen {
 //   p(x) = (w_f A + w_e B) + w_k C   (the taps at dx = -1, +1; w_k C left out if !Corners)
 //   d(x) = q(x) + (p(x - 1) + p(x + 1))
 // (each sum of products a chain of std::fma from the left). box_row_profile evaluates p and q
-// at one x; box_row_diffusion_cells d cell by cell (three profiles per cell).
+// at one x; box_row_diffusion_cells d cell by cell (each profile once, the last three kept).
 template <bool Corners>
 inline void box_row_profile(const double* const* rows, const double* w, int x, double& p,
                             double& q) {
@@ -32,12 +32,16 @@ inline void box_row_profile(const double* const* rows, const double* w, int x, d
 template <bool Corners>
 inline void box_row_diffusion_cells(const double* const* rows, const double* w, int x0, int len,
                                     double* __restrict__ d) {
+  if (len <= 0) return;
+  double pl, ql, pc, qc, pr, qr;
+  box_row_profile<Corners>(rows, w, x0 - 1, pl, ql);
+  box_row_profile<Corners>(rows, w, x0, pc, qc);
   for (int t = 0; t < len; ++t) {
-    double pl, pr, pc, q, qx;
-    box_row_profile<Corners>(rows, w, x0 + t - 1, pl, qx);
-    box_row_profile<Corners>(rows, w, x0 + t, pc, q);
-    box_row_profile<Corners>(rows, w, x0 + t + 1, pr, qx);
-    d[t] = q + (pl + pr);
+    box_row_profile<Corners>(rows, w, x0 + t + 1, pr, qr);
+    d[t] = qc + (pl + pr);
+    pl = pc;
+    pc = pr;
+    qc = qr;
   }
 }
 

@@ -31,9 +31,8 @@ ExplicitIntegrator::ExplicitIntegrator(const Grid& grid, const Halo& halo, RowFn
   if (params_.any_field())
     params_.expand_scalars(static_cast<size_t>(grid.owned().m[0]), const_rows_);
   const GridSpec& g = grid.spec();
-  if (!rows_.box && g.bc[0] == Boundary::Periodic && g.stencil_width == 1 &&
-      grid.ownership_ranges()[0].size() == 1)
-    x_halo_ = std::make_unique<Halo>(grid, false);
+  x_fill_ = !rows_.box && g.bc[0] == Boundary::Periodic && g.stencil_width == 1 &&
+            grid.ownership_ranges()[0].size() == 1;
 }
 
 double ExplicitIntegrator::stable_dt(const Stencil& stencil, const std::vector<double>& D) {
@@ -147,6 +146,7 @@ void ExplicitIntegrator::step(std::vector<VecH>& u, double t, double dt, PetscIn
   // Coefficients and Dirichlet values using t: at the step's start (before the ghosts take the
   // boundary values).
   if (terms_) terms_->set_time(t);
+  if (fills_x() && !x_halo_) x_halo_ = std::make_unique<Halo>(grid_, false); // collective
   exchange(u, fills_x() ? *x_halo_ : halo_);
   if (terms_) terms_->refresh(u); // solution-dependent diffusion: coefficients of u^n
   if (others_.empty()) {

@@ -160,13 +160,14 @@ private:
   // other row's x ghosts are read), x periodic and not split between ranks, one ghost layer,
   // the fast path without other terms. Each row's two x ghosts lie in their own cache lines,
   // which the halo update would fetch from memory once more.
-  bool fills_x() const { return x_halo_ && ops_.empty() && others_.empty(); }
+  bool fills_x() const { return x_fill_ && ops_.empty() && others_.empty(); }
   // p[-1] = p[n - 1], p[n] = p[0] for `rows` rows of every species from cell c (stride gx).
   void wrap_x(const std::vector<PetscScalar*>& u, PetscInt c, int rows, PetscInt gx) const;
 
   const Grid& grid_;
   const Halo& halo_;
-  std::unique_ptr<Halo> x_halo_; // halo_ without the x ghosts (null where !fills_x())
+  bool x_fill_ = false;          // the grid and stencil conditions of fills_x()
+  std::unique_ptr<Halo> x_halo_; // halo_ without the x ghosts (built by the first such step)
   RowFn row_fn_;
   int ns_;
   Stencil stencil_;
