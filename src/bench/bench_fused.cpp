@@ -72,6 +72,8 @@ void bench_fused(MPI_Comm comm, Options& opt, const FusedSettings& fs, double ro
   const PetscInt steps = fs.steps;
   const PetscInt kmax = *std::max_element(depth.begin(), depth.end());
   print_row_kernel_bounds(comm, stencil, 2, roof, 512); // 2 x 3 rows of 4 KiB: in L1
+  if (kmax > 1) // rows of a 4096-wide slab's tiles at k = 8 (FusedSweep's automatic width)
+    print_fused_ring_bound(comm, stencil, roof, 2048, static_cast<int>(kmax));
   for (const auto& n : fs.ns) {
     const std::vector<std::pair<std::string, std::string>> o = {
         {"-model", "gray_scott"},

@@ -2,7 +2,8 @@
 // Gray-Scott cell-updates per second at the grid sides -bench_fuse_n (2-D, periodic, the
 // -bench_fuse_stencil stencil) with k = 1 and each fused depth k of -bench_fuse_steps, the ratio
 // to k = 1 and to the single-step bandwidth roofline `roof` (target >= 1.5 at 4096^2), after the
-// row kernel's own rate and the bounds it sets (bench/bench_kernel_rate.hpp). One
+// row kernel's own rate and the bounds it sets, and (k > 1) the rate of a fused pass's levels
+// with every row in the ring (bench/bench_kernel_rate.hpp). One
 // Simulation per grid, built with the largest k (a pass of n <= k steps is exact for any n).
 #pragma once
 

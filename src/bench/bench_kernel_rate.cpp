@@ -1,6 +1,7 @@
 #include "bench/bench_kernel_rate.hpp"
 
 #include "grid/stencil.hpp"
+#include "integrators/fused_sweep.hpp"
 #include "integrators/kernel_choice.hpp"
 #include "integrators/model_kernels.hpp"
 
@@ -53,14 +54,76 @@ double seconds_of_calls(MPI_Comm comm, ExplicitRowFn fn, const ExplicitRow& row,
   return tmax;
 }
 
-} // namespace
+// The wavefront of a fused pass (integrators/fused_sweep.hpp) over a ring only: level l computes
+// its row jw - l r from the 2r + 1 ring rows of level l - 1, for `levels` levels; level 0's ring
+// rows are filled once (no memory read or written in the loop). Seconds of the slowest rank
+// for `nrows` wavefront rows, best of 5.
+double seconds_of_ring(MPI_Comm comm, ExplicitRowFn fn, ExplicitRow row, const RowStencil& rows,
+                       int levels, long nrows) {
+  const int r = FusedSweep::radius(rows);
+  const long ring = 2 * r + 1, stride = (row.n + 2 + 7) / 8 * 8 + 8;
+  std::vector<double> buf(static_cast<size_t>((levels + 1) * 2 * ring * stride));
+  for (size_t i = 0; i < buf.size(); ++i)
+    buf[i] = (i % 2 ? 0.25 : 0.75) + 1e-3 * static_cast<double>(i % 97);
+  auto at = [&](int l, int s, long j) {
+    return buf.data() + ((l * 2 + s) * ring + j % ring) * stride + 8;
+  };
+  std::vector<const double*> src(static_cast<size_t>(2 * rows.nrows));
+  double* dst[2];
+  row.src = src.data();
+  row.dst = dst;
+  double best = 1e30;
+  for (int rep = 0; rep < 5; ++rep) {
+    MPI_Barrier(comm);
+    const double t0 = MPI_Wtime();
+    for (long jw = levels * r; jw < levels * r + nrows; ++jw)
+      for (int l = 1; l <= levels; ++l) {
+        const long jl = jw - l * r + ring * levels; // (kept non-negative for the ring slots)
+        for (int s = 0; s < 2; ++s) {
+          for (int q = 0; q < rows.nrows; ++q)
+            src[static_cast<size_t>(s * rows.nrows + q)] =
+                at(l - 1, s, jl + rows.off[static_cast<size_t>(q)][0]);
+          dst[s] = at(l, s, jl);
+        }
+        fn(row);
+      }
+    double t = MPI_Wtime() - t0, tmax = 0;
+    MPI_Allreduce(&t, &tmax, 1, MPI_DOUBLE, MPI_MAX, comm);
+    best = std::min(best, tmax);
+  }
+  return best;
+}
 
-RowKernelRate time_row_kernel(MPI_Comm comm, const std::string& stencil, int dim, int n) {
+RowStencil row_stencil(const std::string& stencil, int dim) {
   const double h[3] = {1.0, 1.0, 1.0};
   Stencil st;
   RowStencil rows;
   if (!make_stencil(stencil, dim, h, st) || !to_rows(st, rows))
-    throw std::logic_error("time_row_kernel: stencil " + stencil + " has no row form");
+    throw std::logic_error("bench kernel rate: stencil " + stencil + " has no row form");
+  return rows;
+}
+
+// The Gray-Scott row's constant inputs (D, floor, parameters, dt) for the timing loops.
+struct GrayScottRow {
+  double D[2] = {0.2, 0.1}, floor[2] = {-HUGE_VAL, -HUGE_VAL};
+  double p[3] = {0.035, 0.065, 1.0}; // F, k, s
+};
+
+ExplicitRow gray_scott_row(const GrayScottRow& gs, const RowStencil& rows, int n) {
+  ExplicitRow row;
+  row.n = n;
+  row.w = rows.w.data();
+  row.D = gs.D;
+  row.floor = gs.floor;
+  row.pconst = gs.p;
+  row.dt = 0.5;
+  return row;
+}
+
+} // namespace
+
+RowKernelRate time_row_kernel(MPI_Comm comm, const std::string& stencil, int dim, int n) {
+  const RowStencil rows = row_stencil(stencil, dim);
   // The box stencils' weight-class form where the explicit integrator takes it.
   BoxClasses classes;
   const bool by_class = rows.nrows == 9 && box_classes(rows, classes);
@@ -68,17 +131,10 @@ RowKernelRate time_row_kernel(MPI_Comm comm, const std::string& stencil, int dim
   if (by_class) std::copy(classes.perm.begin(), classes.perm.end(), order);
   KernelRows buf(n);
   buf.point(rows, order);
-  const double D[2] = {0.2, 0.1}, floor[2] = {-HUGE_VAL, -HUGE_VAL};
-  const double p[3] = {0.035, 0.065, 1.0}; // F, k, s
-  ExplicitRow row;
-  row.n = n;
+  const GrayScottRow gs;
+  ExplicitRow row = gray_scott_row(gs, rows, n);
   row.src = buf.src.data();
-  row.w = rows.w.data();
   row.wclass = by_class ? classes.w.data() : nullptr;
-  row.D = D;
-  row.floor = floor;
-  row.pconst = p;
-  row.dt = 0.5;
   row.dst = buf.dst;
   const ModelKernels k = model_kernels<models::GrayScott>();
   const long calls = std::max<long>(1, (1L << 22) / n); // about 4 ms per rep
@@ -95,6 +151,35 @@ RowKernelRate time_row_kernel(MPI_Comm comm, const std::string& stencil, int dim
   if (!wide_vectors_available()) r.ns_per_cell[1] = r.ns_per_cell[0];
   r.ceiling = size / (std::min(r.ns_per_cell[0], r.ns_per_cell[1]) * 1e-9);
   return r;
+}
+
+double time_fused_ring(MPI_Comm comm, const std::string& stencil, int n, int levels) {
+  const RowStencil rows = row_stencil(stencil, 2);
+  const GrayScottRow gs;
+  const ExplicitRow row = gray_scott_row(gs, rows, n);
+  const ModelKernels k = model_kernels<models::GrayScott>();
+  const long nrows = std::max<long>(1, (1L << 22) / (static_cast<long>(n) * levels));
+  double ns = 1e30;
+  for (int wide = 0; wide < (wide_vectors_available() ? 2 : 1); ++wide) {
+    const ExplicitRowFn fn = k.row_kernel(false, rows.nrows, rows.box, wide == 1);
+    const double sec = seconds_of_ring(comm, fn, row, rows, levels, nrows);
+    ns = std::min(ns, sec / (static_cast<double>(nrows) * levels * n) * 1e9);
+  }
+  return ns;
+}
+
+void print_fused_ring_bound(MPI_Comm comm, const std::string& stencil, double roof, int n,
+                            int levels) {
+  int size = 1;
+  MPI_Comm_size(comm, &size);
+  const double ns = time_fused_ring(comm, stencil, n, levels);
+  const double cups = size / (ns * 1e-9);
+  PetscPrintf(comm,
+              "explicit_fused_ring stencil=%s row=%d levels=%d ns_per_cell=%.3f "
+              "cell_updates_per_s=%.4e roofline_fraction=%.3f (a fused pass's levels with every "
+              "row in the ring, the state neither read nor written: what its passes reach at "
+              "most)\n",
+              stencil.c_str(), n, levels, ns, cups, cups / roof);
 }
 
 void print_row_kernel_bounds(MPI_Comm comm, const std::string& stencil, int dim, double roof,

@@ -22,6 +22,14 @@ struct RowKernelRate {
 
 RowKernelRate time_row_kernel(MPI_Comm comm, const std::string& stencil, int dim, int n);
 
+// A fused pass's wavefront (integrators/fused_sweep.hpp) of `levels` levels over rows of n cells
+// of a 2-D stencil, every row in its ring (no memory traffic: the first level's reads and the
+// last level's writes of the state left out): ns per cell-update, faster compile, slowest rank.
+double time_fused_ring(MPI_Comm comm, const std::string& stencil, int n, int levels);
+// Prints it as explicit_fused_ring with its rate on all ranks and fraction of `roof`.
+void print_fused_ring_bound(MPI_Comm comm, const std::string& stencil, double roof, int n,
+                            int levels);
+
 // Prints the kernel's rates on rows of n cells, the ceiling and the serial bound against `roof`
 // (cell-updates/s).
 void print_row_kernel_bounds(MPI_Comm comm, const std::string& stencil, int dim, double roof,

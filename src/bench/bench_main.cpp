@@ -13,7 +13,8 @@
 // figures). Before all that (-bench_output_n, issue 13 parts 3-4, bench/bench_output.hpp): the
 // setup ns per cell, the PNG time and the peak memory per cell at 4096^2. Last line:
 // Then (-bench_fuse_steps, bench/bench_fused.hpp): the row kernel alone with its rows in cache
-// and the bounds it sets (bench/bench_kernel_rate.hpp), fused explicit steps (temporal blocking)
+// and the bounds it sets, the fused wavefront over its ring alone (bench/bench_kernel_rate.hpp),
+// fused explicit steps (temporal blocking)
 // at 2048^2 and 4096^2 against one step per pass and the roofline. Last line:
 //   roofline_fraction=<2-D fraction>
 #include "app/pattern_summary.hpp"

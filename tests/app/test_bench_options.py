@@ -94,3 +94,11 @@ def test_fused_section_keeps_its_depths(tmp_path):
     assert ceil and serial and roof, p.stdout
     c, s, r = float(ceil.group(1)), float(serial.group(1)), float(roof.group(1))
     assert abs(s - 1.0 / (1.0 / c + 1.0 / r)) <= 1e-3 * s, p.stdout
+    # The fused wavefront over its ring alone, at the section's largest k.
+    ring = re.search(r"^explicit_fused_ring stencil=9pt row=2048 levels=4 ns_per_cell=(\S+) "
+                     r"cell_updates_per_s=(\S+) roofline_fraction=(\S+) ", p.stdout, re.M)
+    ranks = re.search(r"^ranks=(\d+)", p.stdout, re.M)
+    assert ring and ranks, p.stdout
+    ns, cups, frac = (float(ring.group(i)) for i in (1, 2, 3))
+    assert ns > 0 and abs(cups - int(ranks.group(1)) / (ns * 1e-9)) <= 1e-3 * cups, p.stdout
+    assert abs(frac - cups / r) <= 1e-3 * frac, p.stdout
