@@ -44,14 +44,21 @@ struct KernelRows {
   }
 };
 
-double seconds_of_calls(MPI_Comm comm, ExplicitRowFn fn, const ExplicitRow& row, long calls) {
+// Seconds of the slowest rank for f(), all ranks starting together.
+template <class F> double slowest_seconds(MPI_Comm comm, F&& f) {
   MPI_Barrier(comm);
   const double t0 = MPI_Wtime();
-  for (long c = 0; c < calls; ++c)
-    fn(row);
+  f();
   double t = MPI_Wtime() - t0, tmax = 0;
   MPI_Allreduce(&t, &tmax, 1, MPI_DOUBLE, MPI_MAX, comm);
   return tmax;
+}
+
+double seconds_of_calls(MPI_Comm comm, ExplicitRowFn fn, const ExplicitRow& row, long calls) {
+  return slowest_seconds(comm, [&] {
+    for (long c = 0; c < calls; ++c)
+      fn(row);
+  });
 }
 
 // The wavefront of a fused pass (integrators/fused_sweep.hpp) over a ring only: level l computes
@@ -73,9 +80,7 @@ double seconds_of_ring(MPI_Comm comm, ExplicitRowFn fn, ExplicitRow row, const R
   row.src = src.data();
   row.dst = dst;
   double best = 1e30;
-  for (int rep = 0; rep < 5; ++rep) {
-    MPI_Barrier(comm);
-    const double t0 = MPI_Wtime();
+  auto wavefront = [&] {
     for (long jw = levels * r; jw < levels * r + nrows; ++jw)
       for (int l = 1; l <= levels; ++l) {
         const long jl = jw - l * r + ring * levels; // (kept non-negative for the ring slots)
@@ -87,10 +92,9 @@ double seconds_of_ring(MPI_Comm comm, ExplicitRowFn fn, ExplicitRow row, const R
         }
         fn(row);
       }
-    double t = MPI_Wtime() - t0, tmax = 0;
-    MPI_Allreduce(&t, &tmax, 1, MPI_DOUBLE, MPI_MAX, comm);
-    best = std::min(best, tmax);
-  }
+  };
+  for (int rep = 0; rep < 5; ++rep)
+    best = std::min(best, slowest_seconds(comm, wavefront));
   return best;
 }
 
