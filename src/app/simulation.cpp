@@ -657,11 +657,12 @@ void Simulation::read_fuse(Options& opt) {
     if (split_fuse_) read_split_fuse();
     return;
   }
-  const PetscInt k = opt.integer(
-      key, 1, 1, 64,
+  const PetscInt asked = opt.integer(
+      key, 0, 0, 64,
       "explicit steps fused per pass over the grid (temporal blocking: a k-cell halo exchanged "
-      "once per k steps; 2-D periodic fast path, else 1; results bitwise those of 1)");
-  integrator_->set_fuse_steps(static_cast<int>(k));
+      "once per k steps; 2-D periodic fast path, else 1; results bitwise those of 1); 0: "
+      "automatic, 8 where fused steps apply and the state averages at least 8 MiB per rank, "
+      "else 1");
   integrator_->set_fuse_tile(opt.integer(
       "explicit_fuse_tile", 0, 0, 1 << 30,
       "owned columns per tile of a fused pass (0: automatic, the widest tile whose rows of the "
@@ -684,10 +685,17 @@ void Simulation::read_fuse(Options& opt) {
                                                : ExplicitIntegrator::Prefetch::Auto);
   read_vector_width(opt);
   const std::string why = fuse_blocker(integrator_->fuse_unsupported());
+  const PetscInt k = asked > 0 ? asked : why.empty() ? integrator_->auto_fuse_steps() : 1;
+  integrator_->set_fuse_steps(static_cast<int>(k));
   fuse_ = why.empty() ? k : 1;
-  if (k > 1 && !why.empty())
+  if (asked > 1 && !why.empty())
     PetscPrintf(comm_, "explicit_fuse_steps %lld: fused steps need %s; one step per pass\n",
-                static_cast<long long>(k), why.c_str());
+                static_cast<long long>(asked), why.c_str());
+  if (asked == 0 && fuse_ > 1)
+    PetscPrintf(comm_,
+                "explicit_fuse_steps auto: up to %lld steps per pass (a large state; "
+                "-explicit_fuse_steps 1: one step per pass, the same results)\n",
+                static_cast<long long>(fuse_));
 }
 
 // -explicit_vector_width auto|256|512: which compile of the fused row kernel the explicit

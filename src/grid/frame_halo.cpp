@@ -8,7 +8,7 @@
 
 namespace morphogen {
 
-FrameHalo::FrameHalo(const Grid& grid, int width) : width_(width) {
+FrameHalo::FrameHalo(const Grid& grid, int width, Source source) : width_(width) {
   const GridSpec& g = grid.spec();
   if (grid.dim() != 2 || g.bc[0] != Boundary::Periodic || g.bc[1] != Boundary::Periodic ||
       width < 1)
@@ -17,7 +17,7 @@ FrameHalo::FrameHalo(const Grid& grid, int width) : width_(width) {
   lx_ = ob.m[0] + 2 * width;
   ly_ = ob.m[1] + 2 * width;
   const auto ax = grid.axis_ranges();
-  const PetscInt sw = g.stencil_width; // the owners' ghosted local arrays
+  const PetscInt sw = source == Source::Ghosted ? g.stencil_width : 0; // the owners' arrays
   std::vector<PetscSFNode> remotes;
   auto add = [&](PetscInt i, PetscInt j) { // global (unwrapped) cell of the frame
     const PetscInt c[2] = {(i % g.n[0] + g.n[0]) % g.n[0], (j % g.n[1] + g.n[1]) % g.n[1]};
@@ -37,8 +37,9 @@ FrameHalo::FrameHalo(const Grid& grid, int width) : width_(width) {
   }
   size_ = static_cast<PetscInt>(remotes.size());
   MG_PETSC(PetscSFCreate(grid.comm(), sf_.out()));
-  MG_PETSC(PetscSFSetGraph(sf_, grid.ghosted().size(), size_, nullptr, PETSC_COPY_VALUES,
-                           remotes.data(), PETSC_COPY_VALUES));
+  const PetscInt roots = source == Source::Ghosted ? grid.ghosted().size() : grid.owned().size();
+  MG_PETSC(PetscSFSetGraph(sf_, roots, size_, nullptr, PETSC_COPY_VALUES, remotes.data(),
+                           PETSC_COPY_VALUES));
   MG_PETSC(PetscSFSetUp(sf_));
 }
 

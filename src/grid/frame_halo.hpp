@@ -18,8 +18,11 @@ namespace morphogen {
 
 class FrameHalo {
 public:
-  // width W >= 1; the grid must be 2-D with both axes periodic. Collective.
-  FrameHalo(const Grid& grid, int width);
+  // width W >= 1; the grid must be 2-D with both axes periodic. fill() reads the owners' ghosted
+  // local arrays (Source::Ghosted) or their owned arrays (Source::Owned, e.g. a parameter field's
+  // global vector). Collective.
+  enum class Source { Ghosted, Owned };
+  FrameHalo(const Grid& grid, int width, Source source = Source::Ghosted);
 
   int width() const { return width_; }
   PetscInt lx() const { return lx_; }
@@ -29,8 +32,8 @@ public:
   // rows, else the left strip (W cells) followed by the right strip (W cells).
   PetscInt row_offset(PetscInt jw) const { return offset_[static_cast<size_t>(jw)]; }
   bool owned_row(PetscInt jw) const { return jw >= width_ && jw < ly_ - width_; }
-  // Fill the frame arrays f[s] (size() each) from the owned cells of the ghosted local arrays
-  // local[s] of every rank, all species' messages in flight together. Collective.
+  // Fill the frame arrays f[s] (size() each) from the owned cells of the arrays local[s] (ghosted
+  // or owned, as constructed) of every rank, all species' messages in flight together. Collective.
   void fill(const std::vector<const double*>& local, const std::vector<double*>& f) const;
 
 private:

@@ -207,12 +207,21 @@ std::string ExplicitIntegrator::fuse_unsupported() const {
   return "";
 }
 
+int ExplicitIntegrator::auto_fuse_steps() const {
+  if (!fuse_unsupported().empty()) return 1;
+  int ranks = 1;
+  MPI_Comm_size(grid_.comm(), &ranks);
+  const double bytes = 8.0 * ns_ * static_cast<double>(grid_.global_cells()) / ranks;
+  return bytes >= kAutoFuseBytes ? kAutoFuseSteps : 1;
+}
+
 void ExplicitIntegrator::steps(std::vector<VecH>& u, double t, double dt, int n) {
   if (n <= 1) {
     step(u, t, dt, 0);
     return;
   }
-  if (work_.empty())
+  const bool in_place = this->in_place(); // the pass writes the state it reads (no second set)
+  if (work_.empty() && !in_place)
     for (int s = 0; s < ns_; ++s)
       work_.push_back(grid_.create_local());
   if (!fused_) {
@@ -223,8 +232,11 @@ void ExplicitIntegrator::steps(std::vector<VecH>& u, double t, double dt, int n)
   std::vector<const PetscScalar*> in(ns_);
   std::vector<PetscScalar*> out(ns_);
   for (int s = 0; s < ns_; ++s) {
-    MG_PETSC(VecGetArrayRead(u[s], &in[s]));
-    MG_PETSC(VecGetArray(work_[s], &out[s]));
+    MG_PETSC(VecGetArray(in_place ? u[s] : work_[s], &out[s]));
+    if (in_place)
+      in[s] = out[s];
+    else
+      MG_PETSC(VecGetArrayRead(u[s], &in[s]));
   }
   ExplicitRow row;
   row.w = rows_.w.data();
@@ -236,10 +248,10 @@ void ExplicitIntegrator::steps(std::vector<VecH>& u, double t, double dt, int n)
   fused_->run(in, out, n, row, fused_choice_.next());
   fused_choice_.record(fused_choice_.timing() ? seconds_since(t0) / n : 0.0);
   for (int s = 0; s < ns_; ++s) {
-    MG_PETSC(VecRestoreArrayRead(u[s], &in[s]));
-    MG_PETSC(VecRestoreArray(work_[s], &out[s]));
+    MG_PETSC(VecRestoreArray(in_place ? u[s] : work_[s], &out[s]));
+    if (!in_place) MG_PETSC(VecRestoreArrayRead(u[s], &in[s]));
   }
-  std::swap(u, work_);
+  if (!in_place) std::swap(u, work_);
 }
 
 void ExplicitIntegrator::step(std::vector<VecH>& u, std::vector<VecH>& work, double dt) const {

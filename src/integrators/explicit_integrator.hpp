@@ -31,7 +31,8 @@
 // advances n <= k steps in one pass with a k r wide halo exchanged once; bitwise the same as n
 // calls of step(). Only the fast path on a 2-D grid periodic on both axes, with no terms or
 // constraints besides the kernel's floor (fuse_unsupported() says which condition fails; then
-// fuse_steps() is 1); parameters must not change between steps (the caller's check).
+// fuse_steps() is 1); parameters must not change between steps (the caller's check). A pass
+// updates the state in place where single steps do (in_place()).
 #pragma once
 
 #include "core/prefetch.hpp"
@@ -114,8 +115,14 @@ public:
   // timings where they were chosen by timing).
   std::string vector_width() const;
 
-  // Temporal blocking: up to k >= 1 steps per pass (1: one step per pass, the default).
+  // Temporal blocking: up to k >= 1 steps per pass (1: one step per pass).
   void set_fuse_steps(int k) { fuse_request_ = k; }
+  // The automatic depth (-explicit_fuse_steps 0): kAutoFuseSteps where fused steps apply and the
+  // state averages at least kAutoFuseBytes per rank (out of the per-core caches, where a pass's
+  // single read and write of the state pays; the same on every rank), else 1.
+  static constexpr int kAutoFuseSteps = 8;
+  static constexpr double kAutoFuseBytes = kInPlaceBytes;
+  int auto_fuse_steps() const;
   // Owned columns per tile of the fused sweep (0: automatic, FusedSweep::tile_width).
   void set_fuse_tile(PetscInt columns) { fuse_tile_ = columns; }
   // Why this run cannot fuse steps ("" when it can).

@@ -1,11 +1,11 @@
 #include "integrators/fused_sweep.hpp"
 
 #include "core/log_events.hpp"
-#include "grid/wide_halo.hpp"
 
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
+#include <stdexcept>
 
 namespace morphogen {
 
@@ -29,29 +29,39 @@ FusedSweep::FusedSweep(const Grid& grid, const RowStencil& rows, int nspecies, i
 
 void FusedSweep::set_params(const ParamSet& params) {
   const size_t np = params.scalar.size();
+  params_ = &params;
   pwide_.assign(np, {});
   pfield_.assign(np, false);
-  const Box& ob = grid_.owned();
-  WideHalo wide(grid_, frame_.width()); // periodic: the box is owned +- W, Lx by Ly
-  VecH local = grid_.create_local();
+  pslots_ = static_cast<PetscInt>(depth_) * r_ + 1;
+  pring_buf_.assign(np * static_cast<size_t>(pslots_ * stride_), 0.0);
+  const FrameHalo frame(grid_, frame_.width(), FrameHalo::Source::Owned);
   for (size_t q = 0; q < np; ++q) {
     if (!params.field[q].get()) {
       pwide_[q].assign(static_cast<size_t>(frame_.lx()), params.scalar[q]);
       continue;
     }
     pfield_[q] = true;
+    pwide_[q].resize(static_cast<size_t>(frame.size()));
     const PetscScalar* f;
-    PetscScalar* l;
     MG_PETSC(VecGetArrayRead(params.field[q], &f));
-    MG_PETSC(VecGetArray(local, &l));
-    for (PetscInt j = ob.s[1]; j < ob.s[1] + ob.m[1]; ++j)
-      std::memcpy(l + grid_.local_index(ob.s[0], j, 0), f + grid_.owned_index(ob.s[0], j, 0),
-                  sizeof(double) * ob.m[0]);
-    pwide_[q].resize(static_cast<size_t>(wide.size()));
-    wide.fill(l, pwide_[q].data());
-    MG_PETSC(VecRestoreArray(local, &l));
+    frame.fill({f}, {pwide_[q].data()});
     MG_PETSC(VecRestoreArrayRead(params.field[q], &f));
   }
+}
+
+void FusedSweep::load_param_row(size_t q, const double* f, PetscInt jw, PetscInt c0,
+                                PetscInt c1) const {
+  const double* fr = pwide_[q].data() + frame_.row_offset(jw);
+  double* dst = param_row(q, jw);
+  if (!frame_.owned_row(jw)) {
+    std::memcpy(dst + c0, fr + c0, sizeof(double) * (c1 - c0));
+    return;
+  }
+  const PetscInt W = frame_.width(), mx = grid_.owned().m[0];
+  const PetscInt a = std::clamp(W, c0, c1), b = std::clamp(W + mx, a, c1);
+  std::memcpy(dst + c0, fr + c0, sizeof(double) * (a - c0));                   // left strip
+  std::memcpy(dst + a, f + (jw - W) * mx + (a - W), sizeof(double) * (b - a)); // owned
+  std::memcpy(dst + b, fr + W + (b - W - mx), sizeof(double) * (c1 - b));      // right strip
 }
 
 // Row jw of the input box for step 1, as two bases indexed by box column x: `edge` for the
@@ -60,8 +70,8 @@ void FusedSweep::set_params(const ParamSet& params) {
 // the strips and the owned row's first and last two cells are copied into the level-0 ring
 // (edge), so step 1's row splits into three calls (run). Narrow rows (mx < kInPlaceMin) are
 // copied whole (edge = mid = the ring row).
-FusedSweep::InputRow FusedSweep::input_row(const std::vector<const double*>& in, int s,
-                                           PetscInt jw) const {
+FusedSweep::InputRow FusedSweep::input_row(const std::vector<const double*>& in, int s, PetscInt jw,
+                                           const LeftStrip& left) const {
   const double* f = frame_buf_[s].data() + frame_.row_offset(jw);
   if (!frame_.owned_row(jw)) return {f, f};
   const Box& ob = grid_.owned();
@@ -70,13 +80,44 @@ FusedSweep::InputRow FusedSweep::input_row(const std::vector<const double*>& in,
   const double* own = in[s] + grid_.local_index(ob.s[0], ob.s[1] - W + jw, 0);
   std::memcpy(row, f, sizeof(double) * W);
   std::memcpy(row + W + mx, f + W, sizeof(double) * W);
-  if (mx < kInPlaceMin) {
+  const bool whole = mx < kInPlaceMin;
+  if (whole) {
     std::memcpy(row + W, own, sizeof(double) * mx);
-    return {row, row};
+  } else {
+    std::memcpy(row + W, own, sizeof(double) * 2);
+    std::memcpy(row + W + mx - 2, own + mx - 2, sizeof(double) * 2);
   }
-  std::memcpy(row + W, own, sizeof(double) * 2);
-  std::memcpy(row + W + mx - 2, own + mx - 2, sizeof(double) * 2);
-  return {row, own - W};
+  if (left.c0 < left.t0) { // in place: the columns left of the tile as they were, its first two
+    const PetscInt w = left.t0 - left.c0;
+    std::memcpy(row + left.c0, left.data[s] + (jw - W) * w, sizeof(double) * w);
+    const PetscInt live = std::min<PetscInt>(2, W + mx - left.t0);
+    std::memcpy(row + left.t0, own + (left.t0 - W), sizeof(double) * live);
+  }
+  return whole ? InputRow{row, row} : InputRow{row, own - W};
+}
+
+// In place: the owned columns [max(t0 - n, W), t0) of every owned row (box coordinates), which
+// the tiles left of t0 overwrite before the tile at t0 reads them.
+FusedSweep::LeftStrip FusedSweep::save_left_strip(const std::vector<const double*>& in, int n,
+                                                  PetscInt t0, size_t tile) const {
+  const Box& ob = grid_.owned();
+  const PetscInt W = frame_.width();
+  LeftStrip left;
+  left.t0 = t0;
+  left.c0 = std::max<PetscInt>(t0 - n, W);
+  const PetscInt w = t0 - left.c0;
+  if (w <= 0) return left;
+  if (strip_buf_.size() < (tile + 1) * ns_) strip_buf_.resize((tile + 1) * ns_);
+  for (int s = 0; s < ns_; ++s) {
+    std::vector<double>& buf = strip_buf_[tile * ns_ + s];
+    buf.resize(static_cast<size_t>(w * ob.m[1]));
+    for (PetscInt jo = 0; jo < ob.m[1]; ++jo)
+      std::memcpy(buf.data() + jo * w,
+                  in[s] + grid_.local_index(ob.s[0] + left.c0 - W, ob.s[1] + jo, 0),
+                  sizeof(double) * w);
+    left.data.push_back(buf.data());
+  }
+  return left;
 }
 
 // Columns per tile of a pass of n steps: the given width, else the widest whose ring rows
@@ -103,15 +144,31 @@ void FusedSweep::run(const std::vector<const double*>& in, const std::vector<dou
   const PetscInt W = frame_.width(), mx = grid_.owned().m[0];
   const PetscInt width = tile_width(n);
   const PetscInt tiles = std::max<PetscInt>(1, (mx + width - 1) / width);
+  bool in_place = true;
+  for (int s = 0; s < ns_; ++s)
+    in_place = in_place && out[s] == in[s];
+  if (in_place && n < 2)
+    throw std::invalid_argument("FusedSweep::run: in place needs at least 2 steps per pass");
+  std::vector<LeftStrip> left(static_cast<size_t>(tiles)); // all saved before any tile writes
+  for (PetscInt t = 0; t < tiles; ++t) {
+    const PetscInt t0 = W + t * mx / tiles;
+    left[t] = in_place ? save_left_strip(in, n, t0, static_cast<size_t>(t)) : LeftStrip{t0, t0, {}};
+  }
+  std::vector<const double*> pf(pfield_.size(), nullptr);
+  for (size_t q = 0; q < pf.size(); ++q)
+    if (pfield_[q]) MG_PETSC(VecGetArrayRead(params_->field[q], &pf[q]));
   for (PetscInt t = 0; t < tiles; ++t)
-    sweep_tile(in, out, n, row, fn, W + t * mx / tiles, W + (t + 1) * mx / tiles);
+    sweep_tile(in, out, n, row, fn, W + t * mx / tiles, W + (t + 1) * mx / tiles, left[t], pf);
+  for (size_t q = 0; q < pf.size(); ++q)
+    if (pfield_[q]) MG_PETSC(VecRestoreArrayRead(params_->field[q], &pf[q]));
 }
 
 // The owned box columns [t0, t1) (box coordinates): step l computes the columns
 // [t0 - (n - l), t1 + (n - l)) of its rows (x taps reach one cell), step 1 reading box columns
 // t0 - n .. t1 + n - 1 of the input rows.
 void FusedSweep::sweep_tile(const std::vector<const double*>& in, const std::vector<double*>& out,
-                            int n, ExplicitRow row, RowFn fn, PetscInt t0, PetscInt t1) const {
+                            int n, ExplicitRow row, RowFn fn, PetscInt t0, PetscInt t1,
+                            const LeftStrip& left, const std::vector<const double*>& pf) const {
   const Box& ob = grid_.owned();
   const PetscInt W = frame_.width(), lx = frame_.lx(), ly = frame_.ly(), mx = ob.m[0];
   const int nr = rows_.nrows;
@@ -141,14 +198,16 @@ void FusedSweep::sweep_tile(const std::vector<const double*>& in, const std::vec
                x0;
     }
     for (size_t q = 0; q < np; ++q)
-      prow[q] = pwide_[q].data() + (pfield_[q] ? jl * lx : 0) + x0;
+      prow[q] = (pfield_[q] ? param_row(q, jl) : pwide_[q].data()) + x0;
     row.n = static_cast<int>(x1 - x0);
     fn(row);
   };
   const PetscInt e0 = margin(0);
   for (PetscInt jw = e0; jw < ly - e0; ++jw) {
     for (int s = 0; s < ns_; ++s)
-      in0_[s][jw % ring_] = input_row(in, s, jw);
+      in0_[s][jw % ring_] = input_row(in, s, jw, left);
+    for (size_t q = 0; q < np; ++q) // the columns step 1 computes (later steps compute fewer)
+      if (pfield_[q]) load_param_row(q, pf[q], jw, t0 - (n - 1), t1 + (n - 1));
     for (int l = 1; l <= n; ++l) {
       const PetscInt jl = jw - static_cast<PetscInt>(l) * r_, e = margin(l);
       if (jl < e || jl >= ly - e) continue;
@@ -159,8 +218,10 @@ void FusedSweep::sweep_tile(const std::vector<const double*>& in, const std::vec
         sweep_row(l, jl, a, b, false);
         continue;
       }
-      // Step 1: the owned row in place between its second and second-last cell.
-      const PetscInt m0 = std::clamp(W + 1, a, b), m1 = std::clamp(W + mx - 1, m0, b);
+      // Step 1: the owned row in place between its second (in place: the tile's second) and
+      // second-last cell.
+      const PetscInt lo = left.c0 < left.t0 ? left.t0 + 1 : W + 1;
+      const PetscInt m0 = std::clamp(lo, a, b), m1 = std::clamp(W + mx - 1, m0, b);
       sweep_row(1, jl, a, m0, false);
       sweep_row(1, jl, m0, m1, true);
       sweep_row(1, jl, m1, b, false);

@@ -13,8 +13,14 @@
 // ring of 2r + 1 rows per species (2r + 1 rows of Lx cells per step and species stay in cache); the
 // last step writes the owned row of the output arrays. Memory traffic per n steps: one read
 // and one write of the state, instead of n of each.
-// Per-cell parameters (field mode): each field is copied once into the wide box (WideHalo) and
-// each scalar into a row of Lx copies (set_params); they must not change afterwards.
+// In place (out == in): step n writes row j of a tile only after step 1 has read it for the last
+// time (n >= 2), so only the columns a tile reads left of its own, which the tiles before it have
+// overwritten, are saved: per tile after the first, its n columns left of it of every owned row,
+// copied once at the start of the pass (no second state set).
+// Per-cell parameters (field mode): each field's frame is filled once (set_params; the fields must
+// not change afterwards) and each scalar copied into a row of Lx values; per pass, each row of a
+// field is assembled once (frame strips and the owned row) into a ring of depth r + 1 rows read
+// by every step (no copy of a field over the whole box).
 #pragma once
 
 #include "fields/param_set.hpp"
@@ -34,7 +40,7 @@ public:
   // tile: owned columns per tile (0: auto, ring rows within kTileBytes; see run).
   FusedSweep(const Grid& grid, const RowStencil& rows, int nspecies, int depth, PetscInt tile = 0);
 
-  // Field mode: the parameters of every cell of the wide box (fields fixed in time). Collective.
+  // Field mode: the parameters (fields fixed in time; `params` must outlive the sweep). Collective.
   void set_params(const ParamSet& params);
 
   // The stencil radius along y (x taps always reach 1 cell).
@@ -42,8 +48,8 @@ public:
   int depth() const { return depth_; }
 
   // n steps (1 <= n <= depth): in[s], out[s] ghosted local arrays of species s (owned cells of
-  // `in` current; the owned cells of `out` written). `row` carries w, D, floor, pconst and dt;
-  // src, dst and n are set here. Collective.
+  // `in` current; the owned cells of `out` written; out[s] == in[s] for every s: in place).
+  // `row` carries w, D, floor, pconst and dt; src, dst and n are set here. Collective.
   void run(const std::vector<const double*>& in, const std::vector<double*>& out, int n,
            ExplicitRow row, RowFn fn) const;
 
@@ -59,11 +65,27 @@ private:
   // Narrower owned rows are copied whole: one kernel call per row (at 64 cells three calls cost
   // more than the copy saves).
   static constexpr PetscInt kInPlaceMin = 512;
-  InputRow input_row(const std::vector<const double*>& in, int s, PetscInt jw) const;
+  // In place: the saved input columns [c0, t0) of every owned row for the tile starting at box
+  // column t0 (data: per species, rows of t0 - c0 values), or none (c0 == t0).
+  struct LeftStrip {
+    PetscInt c0 = 0, t0 = 0;
+    std::vector<const double*> data;
+  };
+  InputRow input_row(const std::vector<const double*>& in, int s, PetscInt jw,
+                     const LeftStrip& left) const;
+  double* param_row(size_t q, PetscInt jw) const {
+    const size_t slot = static_cast<size_t>(jw % pslots_);
+    return pring_buf_.data() + (q * static_cast<size_t>(pslots_) + slot) * stride_;
+  }
+  // Box columns [c0, c1) of row jw of parameter field q (owned values f) into param_row(q, jw).
+  void load_param_row(size_t q, const double* f, PetscInt jw, PetscInt c0, PetscInt c1) const;
+  LeftStrip save_left_strip(const std::vector<const double*>& in, int n, PetscInt t0,
+                            size_t tile) const;
   static constexpr double kTileBytes = 1024.0 * 1024; // ring rows of one tile: half an L2
   PetscInt tile_width(int n) const;                   // owned columns per tile of a pass of n steps
   void sweep_tile(const std::vector<const double*>& in, const std::vector<double*>& out, int n,
-                  ExplicitRow row, RowFn fn, PetscInt t0, PetscInt t1) const;
+                  ExplicitRow row, RowFn fn, PetscInt t0, PetscInt t1, const LeftStrip& left,
+                  const std::vector<const double*>& pf) const;
 
   const Grid& grid_;
   RowStencil rows_;
@@ -76,8 +98,12 @@ private:
   mutable std::vector<std::vector<double>> frame_buf_; // per species
   mutable std::vector<double> ring_buf_;               // [level][species][slot][stride]
   mutable std::vector<std::vector<InputRow>> in0_;     // level 0 rows per species and slot
-  std::vector<std::vector<double>> pwide_; // field mode: per parameter, Lx * Ly or Lx cells
-  std::vector<bool> pfield_;               // parameter q is a field (else one row of Lx)
+  mutable std::vector<std::vector<double>> strip_buf_; // in place: per tile, saved left columns
+  const ParamSet* params_ = nullptr;                   // field mode
+  std::vector<std::vector<double>> pwide_; // per parameter: a scalar's row of Lx, a field's frame
+  std::vector<bool> pfield_;               // parameter q is a field
+  PetscInt pslots_ = 1;                    // rows per field in the parameter ring: depth r + 1
+  mutable std::vector<double> pring_buf_;  // [parameter][slot][stride]
 };
 
 } // namespace morphogen

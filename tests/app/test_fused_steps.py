@@ -55,3 +55,27 @@ def test_unsupported_falls_back_with_a_log_line(tmp_path):
              "-explicit_fuse_steps", "4"], tmp_path)
     assert p.returncode == 0, p.stderr
     assert "explicit_fuse_steps 4: fused steps need periodic boundaries on both axes" in p.stdout
+
+
+def test_default_fuses_large_states_in_place(tmp_path):
+    """The default (-explicit_fuse_steps 0, automatic) fuses 8 steps per pass where a rank's
+    state averages at least 8 MiB (2048 x 512 cells of 2 species on 2 ranks), in place, and
+    writes the same bytes as one step per pass; a small grid runs one step per pass, silently."""
+    big = ["-grid_n", "2048,512", "-steps", "21", "-png_every", "0", "-summary", "false",
+           "-progress_every", "1000"]
+    for name, extra in (("auto", []), ("k1", ["-explicit_fuse_steps", "1"])):
+        p = run([DECK] + big + extra + ["-output_dir", name], tmp_path, ranks=2)
+        assert p.returncode == 0, p.stderr
+        if name == "auto":
+            assert "explicit_fuse_steps auto: up to 8 steps per pass" in p.stdout, p.stdout
+            assert "fused steps: 21 steps in 3 passes (up to 8 steps each)" in p.stdout, p.stdout
+        else:
+            assert "fused steps" not in p.stdout
+    a = datasets(str(tmp_path / "k1" / "morphogen_0000021.vtkhdf"))
+    b = datasets(str(tmp_path / "auto" / "morphogen_0000021.vtkhdf"))
+    assert a.keys() == b.keys() and a
+    for name in a:
+        assert np.asarray(a[name]).tobytes() == np.asarray(b[name]).tobytes(), name
+    p = run([DECK, "-grid_n", "64,64", "-steps", "10", "-summary", "false"], tmp_path, ranks=2)
+    assert p.returncode == 0, p.stderr
+    assert "fuse" not in p.stdout

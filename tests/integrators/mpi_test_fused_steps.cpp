@@ -117,6 +117,49 @@ TEST(FusedSteps, WideRowsReadInPlace) {
   EXPECT_TRUE(same_as_single_steps(o, 3, 20, {}));
 }
 
+// In place (-explicit_in_place yes, the default where a rank's state is large): a pass writes the
+// state it reads; the columns left of each tile are saved first. Wide rows in one and in many
+// tiles (narrower than k too), narrow rows, per-cell parameters, k = 2 (the shortest pass that
+// may run in place).
+TEST(FusedSteps, InPlacePasses) {
+  for (const char* tile : {"0", "50", "7"}) {
+    OptionList g = gray_scott("2048,24", "9pt");
+    g[2] = {"grid_L", "51.2,0.6"};
+    g.push_back({"explicit_fuse_tile", tile});
+    g.push_back({"explicit_in_place", "yes"});
+    EXPECT_TRUE(same_as_single_steps(g, 8, 19, {8, 3, 2}));
+  }
+  OptionList o = kTuring;
+  o[0] = {"grid_n", "1100,20"};
+  o[1] = {"params_alpha", "12 +- 0.1% gauss"};
+  o.push_back({"explicit_in_place", "yes"});
+  o.push_back({"explicit_fuse_tile", "130"});
+  EXPECT_TRUE(same_as_single_steps(o, 2, 21, {}));
+  OptionList narrow = gray_scott("40,40", "9pt");
+  narrow.push_back({"explicit_in_place", "yes"});
+  narrow.push_back({"explicit_fuse_tile", "9"});
+  EXPECT_TRUE(same_as_single_steps(narrow, 4, 43, {}));
+  OptionList tiny = gray_scott("12,12", "5pt");
+  tiny.push_back({"explicit_in_place", "yes"});
+  EXPECT_TRUE(same_as_single_steps(tiny, 8, 29, {8, 5}));
+}
+
+// -explicit_fuse_steps 0 (the default): 8 where fused steps apply and the state averages at
+// least 8 MiB per rank (2048 x 1024 cells of 2 species: 32 MiB, on 1, 2 or 4 ranks), else 1.
+TEST(FusedSteps, AutomaticDepth) {
+  auto depth = [](OptionList o) {
+    o.push_back({"explicit_fuse_steps", "0"});
+    return make_sim(PETSC_COMM_WORLD, o)->fuse_steps();
+  };
+  OptionList big = gray_scott("2048,1024", "9pt");
+  big[2] = {"grid_L", "128,64"}; // the spacing of gray_scott("40,40")
+  EXPECT_EQ(depth(big), 8);
+  OptionList neumann = big;
+  neumann.push_back({"grid_bc", "neumann"});
+  EXPECT_EQ(depth(neumann), 1);
+  EXPECT_EQ(depth(gray_scott("256,256", "9pt")), 1);
+}
+
 TEST(FusedSteps, HaloWiderThanNeighbours) { // W = 8 cells, owned extents 6..12
   EXPECT_TRUE(same_as_single_steps(gray_scott("12,12", "5pt"), 8, 29, {8, 5}));
 }
