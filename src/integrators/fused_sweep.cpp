@@ -149,16 +149,16 @@ void FusedSweep::run(const std::vector<const double*>& in, const std::vector<dou
     in_place = in_place && out[s] == in[s];
   if (in_place && n < 2)
     throw std::invalid_argument("FusedSweep::run: in place needs at least 2 steps per pass");
-  std::vector<LeftStrip> left(static_cast<size_t>(tiles)); // all saved before any tile writes
-  for (PetscInt t = 0; t < tiles; ++t) {
-    const PetscInt t0 = W + t * mx / tiles;
-    left[t] = in_place ? save_left_strip(in, n, t0, static_cast<size_t>(t)) : LeftStrip{t0, t0, {}};
-  }
+  auto start = [&](PetscInt t) { return W + t * mx / tiles; }; // box column of tile t
+  std::vector<LeftStrip> left(static_cast<size_t>(tiles));     // all saved before any tile writes
+  for (PetscInt t = 0; t < tiles; ++t)
+    left[t] = in_place ? save_left_strip(in, n, start(t), static_cast<size_t>(t))
+                       : LeftStrip{start(t), start(t), {}};
   std::vector<const double*> pf(pfield_.size(), nullptr);
   for (size_t q = 0; q < pf.size(); ++q)
     if (pfield_[q]) MG_PETSC(VecGetArrayRead(params_->field[q], &pf[q]));
   for (PetscInt t = 0; t < tiles; ++t)
-    sweep_tile(in, out, n, row, fn, W + t * mx / tiles, W + (t + 1) * mx / tiles, left[t], pf);
+    sweep_tile(in, out, n, row, fn, start(t), start(t + 1), left[t], pf);
   for (size_t q = 0; q < pf.size(); ++q)
     if (pfield_[q]) MG_PETSC(VecRestoreArrayRead(params_->field[q], &pf[q]));
 }
@@ -170,7 +170,7 @@ void FusedSweep::sweep_tile(const std::vector<const double*>& in, const std::vec
                             int n, ExplicitRow row, RowFn fn, PetscInt t0, PetscInt t1,
                             const LeftStrip& left, const std::vector<const double*>& pf) const {
   const Box& ob = grid_.owned();
-  const PetscInt W = frame_.width(), lx = frame_.lx(), ly = frame_.ly(), mx = ob.m[0];
+  const PetscInt W = frame_.width(), ly = frame_.ly(), mx = ob.m[0];
   const int nr = rows_.nrows;
   std::vector<const double*> src(static_cast<size_t>(ns_ * nr));
   std::vector<double*> dst(ns_);
