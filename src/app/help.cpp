@@ -57,7 +57,8 @@ const Conditional kConditional[] = {
     {"explicit_",
      "-explicit_fuse_steps K, -explicit_fuse_tile N, -explicit_in_place auto|yes|no, "
      "-explicit_vector_width auto|256|512, -explicit_prefetch auto|yes|no",
-     "with -integrator explicit: K steps fused per pass (temporal blocking), owned columns per "
+     "with -integrator explicit: K steps fused per pass (temporal blocking; 0, the default: 8 "
+     "for large 2-D periodic states, else 1), owned columns per "
      "tile of a fused pass, the in-place update, the row kernel compiled with 256- or "
      "512-bit vectors (auto: timed per rank), and software prefetch of the rows read from "
      "memory; all give the same results"},
