@@ -719,7 +719,7 @@ ExplicitIntegrator::RowFn Simulation::fused_row_kernel(bool wide) const {
   if (!mk.fused) return nullptr;
   RowStencil rows;
   to_rows(stencil_, rows);
-  return mk.row_kernel(params_.any_field(), rows.nrows, rows.box, wide);
+  return mk.row_kernel(params_.field_mask(), rows.nrows, rows.box, wide);
 }
 
 std::string Simulation::explicit_vector_width() const {

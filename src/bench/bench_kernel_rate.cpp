@@ -146,7 +146,7 @@ RowKernelRate time_row_kernel(MPI_Comm comm, const std::string& stencil, int dim
   MPI_Comm_size(comm, &size);
   RowKernelRate r;
   for (int wide = 0; wide < (wide_vectors_available() ? 2 : 1); ++wide) {
-    const ExplicitRowFn fn = k.row_kernel(false, rows.nrows, rows.box, wide == 1);
+    const ExplicitRowFn fn = k.row_kernel(0, rows.nrows, rows.box, wide == 1);
     double best = 1e30;
     for (int rep = 0; rep < 5; ++rep)
       best = std::min(best, seconds_of_calls(comm, fn, row, calls));
@@ -165,7 +165,7 @@ double time_fused_ring(MPI_Comm comm, const std::string& stencil, int n, int lev
   const long nrows = std::max<long>(1, (1L << 22) / (static_cast<long>(n) * levels));
   double ns = 1e30;
   for (int wide = 0; wide < (wide_vectors_available() ? 2 : 1); ++wide) {
-    const ExplicitRowFn fn = k.row_kernel(false, rows.nrows, rows.box, wide == 1);
+    const ExplicitRowFn fn = k.row_kernel(0, rows.nrows, rows.box, wide == 1);
     const double sec = seconds_of_ring(comm, fn, row, rows, levels, nrows);
     ns = std::min(ns, sec / (static_cast<double>(nrows) * levels * n) * 1e9);
   }

@@ -83,7 +83,7 @@ void explicit_steps_host(const GhostedBox& g, const RowStencil& rows,
         a.pconst = k.p;
         a.dt = k.dt;
         a.dst = dst;
-        explicit_row<M, NR, Box, false>(a);
+        explicit_row<M, NR, Box, kScalarParams>(a);
       }
     std::swap(u, tmp);
   }

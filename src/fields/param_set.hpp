@@ -19,6 +19,13 @@ struct ParamSet {
       if (f.get()) return true;
     return false;
   }
+  // Bit q set where parameter q is a field (parameters from the 32nd on: bit 31).
+  unsigned field_mask() const {
+    unsigned m = 0;
+    for (size_t q = 0; q < field.size(); ++q)
+      if (field[q].get()) m |= 1u << (q < 31 ? q : 31);
+    return m;
+  }
   // For kernels in field mode: each scalar parameter as a row of n copies (empty rows for the
   // fields). Called again after the scalars change (parameters using t).
   void expand_scalars(size_t n, std::vector<std::vector<double>>& rows) const {

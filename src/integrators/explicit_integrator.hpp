@@ -59,7 +59,7 @@ public:
   using RowFn = void (*)(const ExplicitRow&);
   // The general path's row update (a std::function: a model built at run time carries state).
   using PreFn = std::function<void(const ExplicitRow&)>;
-  // row_fn must match (nspecies, nparams, the stencil's row form, params.any_field()).
+  // row_fn must match (nspecies, nparams, the stencil's row form, params.field_mask()).
   ExplicitIntegrator(const Grid& grid, const Halo& halo, RowFn row_fn, int nspecies,
                      const Stencil& stencil, std::vector<double> D, std::vector<double> floor,
                      const ParamSet& params, const std::vector<FaceValues>* dirichlet);

@@ -16,8 +16,11 @@
 // (9pt) use all three. One pointer per (species, row) keeps the live registers low (the x
 // neighbours are the same pointer at i -+ 1). floor_s is 0 when negative concentrations are
 // clamped and -inf otherwise; a row whose floors are all -inf takes an instantiation without
-// the max (Clamp = false: the same values, max(v, -inf) = v, NaN kept). Parameters are scalars
-// (FieldParams = false: kept in registers) or rows of per-cell values (FieldParams = true). The
+// the max (Clamp = false: the same values, max(v, -inf) = v, NaN kept). Each parameter q is a
+// scalar (kept in a register: pconst[q]) or a row of per-cell values (prow[q]), as the bits of
+// the compile-time mask PR say (ParamRows: bit q set, a row; the same value either way, so the
+// same bits): a field-mode run whose other parameters are constant reads no row for those (each
+// row read is one more load stream per cell in a kernel bounded by its loads). The
 // loop over i carries `GCC ivdep` (rows never alias); the model's rates() inline into it and GCC
 // vectorises it (configure with -DMORPHOGEN_VEC_REPORT=ON to see "loop vectorized" for this file).
 // (`omp simd` is not used: GCC 12 turns the small per-cell arrays into "simd arrays" and then
@@ -76,7 +79,32 @@ inline bool any_floor(const double* floor, int ns) {
   return false;
 }
 
-template <class M, bool FieldParams, bool Corners, bool Clamp, bool Wide = false>
+// Which parameters a row kernel reads as rows of per-cell values (bit q: parameter q), the
+// others as the scalars pconst. A distinct type, so that no bool converts into it.
+enum class ParamRows : unsigned {};
+constexpr ParamRows kScalarParams{0u};
+constexpr ParamRows kAllParamRows{~0u};
+constexpr bool param_is_row(ParamRows m, int q) {
+  return (static_cast<unsigned>(m) >> q & 1u) != 0;
+}
+constexpr bool any_param_row(ParamRows m) {
+  return static_cast<unsigned>(m) != 0;
+}
+
+// The kernel's NP parameters: the scalars pc (pconst is set in every mode) and, where PR has a
+// row, every row pointer (the kernel reads those of PR; setting all of them keeps GCC's loop
+// from spilling pointers: 15 % faster than setting only those read, for a mask with a scalar
+// among rows, in a harness of the Turing 5pt row).
+template <ParamRows PR, int NP, int NPA>
+inline void load_params(const ExplicitRow& a, const double* __restrict__ (&prow)[NPA],
+                        double (&pc)[NPA]) {
+  for (int q = 0; q < NP; ++q) {
+    pc[q] = a.pconst[q];
+    if constexpr (any_param_row(PR)) prow[q] = a.prow[q];
+  }
+}
+
+template <class M, ParamRows PR, bool Corners, bool Clamp, bool Wide = false>
 inline void explicit_row_box_classes(const ExplicitRow& a) {
   constexpr int NS = M::nspecies;
   constexpr int NP = M::nparams;
@@ -92,12 +120,7 @@ inline void explicit_row_box_classes(const ExplicitRow& a) {
       wc[s][c] = (dt * a.D[s]) * a.wclass[c];
     floor[s] = a.floor[s];
   }
-  for (int q = 0; q < NP; ++q) {
-    if constexpr (FieldParams)
-      prow[q] = a.prow[q];
-    else
-      pc[q] = a.pconst[q];
-  }
+  load_params<PR, NP>(a, prow, pc);
   const int n = a.n;
   alignas(64) double dbuf[NS][kBoxChunk];
   for (int i0 = 0; i0 < n; i0 += kBoxChunk) {
@@ -108,12 +131,8 @@ inline void explicit_row_box_classes(const ExplicitRow& a) {
     for (int x = 0; x < m; ++x) {
       const int i = i0 + x;
       double u[NS], r[NS], p[NP > 0 ? NP : 1];
-      for (int q = 0; q < NP; ++q) {
-        if constexpr (FieldParams)
-          p[q] = prow[q][i];
-        else
-          p[q] = pc[q];
-      }
+      for (int q = 0; q < NP; ++q)
+        p[q] = param_is_row(PR, q) ? prow[q][i] : pc[q];
       for (int s = 0; s < NS; ++s)
         u[s] = src[s][i];
       M::rates(u, p, r);
@@ -125,7 +144,7 @@ inline void explicit_row_box_classes(const ExplicitRow& a) {
   }
 }
 
-template <class M, int NR, bool Box, bool FieldParams, bool Clamp, bool Wide = false>
+template <class M, int NR, bool Box, ParamRows PR, bool Clamp, bool Wide = false>
 inline void explicit_row_taps(const ExplicitRow& a) {
   constexpr int NS = M::nspecies;
   constexpr int NP = M::nparams;
@@ -143,24 +162,15 @@ inline void explicit_row_taps(const ExplicitRow& a) {
     dst[s] = a.dst[s];
     floor[s] = a.floor[s];
   }
-  for (int q = 0; q < NP; ++q) {
-    if constexpr (FieldParams)
-      prow[q] = a.prow[q];
-    else
-      pc[q] = a.pconst[q];
-  }
+  load_params<PR, NP>(a, prow, pc);
   const int n = a.n;
-  const int rows = FieldParams ? 1 : a.rows;
+  const int rows = any_param_row(PR) ? 1 : a.rows;
   for (int j = 0; j < rows; ++j) {
 #pragma GCC ivdep
     for (int i = 0; i < n; ++i) {
       double u[NS], r[NS], p[NP > 0 ? NP : 1];
-      for (int q = 0; q < NP; ++q) {
-        if constexpr (FieldParams)
-          p[q] = prow[q][i];
-        else
-          p[q] = pc[q];
-      }
+      for (int q = 0; q < NP; ++q)
+        p[q] = param_is_row(PR, q) ? prow[q][i] : pc[q];
       for (int s = 0; s < NS; ++s)
         u[s] = src[s * NR][i];
       M::rates(u, p, r);
@@ -186,27 +196,27 @@ inline void explicit_row_taps(const ExplicitRow& a) {
   }
 }
 
-template <class M, int NR, bool Box, bool FieldParams, bool Wide = false>
+template <class M, int NR, bool Box, ParamRows PR, bool Wide = false>
 inline void explicit_row(const ExplicitRow& a) {
   const bool clamp = any_floor(a.floor, M::nspecies);
   if constexpr (NR == 9 && Box) {
     if (a.wclass) {
       const bool corners = a.wclass[3] != 0.0;
       if (clamp && corners)
-        explicit_row_box_classes<M, FieldParams, true, true, Wide>(a);
+        explicit_row_box_classes<M, PR, true, true, Wide>(a);
       else if (clamp)
-        explicit_row_box_classes<M, FieldParams, false, true, Wide>(a);
+        explicit_row_box_classes<M, PR, false, true, Wide>(a);
       else if (corners)
-        explicit_row_box_classes<M, FieldParams, true, false, Wide>(a);
+        explicit_row_box_classes<M, PR, true, false, Wide>(a);
       else
-        explicit_row_box_classes<M, FieldParams, false, false, Wide>(a);
+        explicit_row_box_classes<M, PR, false, false, Wide>(a);
       return;
     }
   }
   if (clamp)
-    explicit_row_taps<M, NR, Box, FieldParams, true, Wide>(a);
+    explicit_row_taps<M, NR, Box, PR, true, Wide>(a);
   else
-    explicit_row_taps<M, NR, Box, FieldParams, false, Wide>(a);
+    explicit_row_taps<M, NR, Box, PR, false, Wide>(a);
 }
 
 // The general path's update of one row: the diffusion terms were computed into div[s] (a row

@@ -32,8 +32,6 @@ void FusedSweep::set_params(const ParamSet& params) {
   params_ = &params;
   pwide_.assign(np, {});
   pfield_.assign(np, false);
-  pslots_ = static_cast<PetscInt>(depth_) * r_ + 1;
-  pring_buf_.assign(np * static_cast<size_t>(pslots_ * stride_), 0.0);
   const FrameHalo frame(grid_, frame_.width(), FrameHalo::Source::Owned);
   for (size_t q = 0; q < np; ++q) {
     if (!params.field[q].get()) {
@@ -49,19 +47,14 @@ void FusedSweep::set_params(const ParamSet& params) {
   }
 }
 
-void FusedSweep::load_param_row(size_t q, const double* f, PetscInt jw, PetscInt c0,
-                                PetscInt c1) const {
+// The frame row (all columns of a frame row; on an owned row its left strip holds [0, W), its
+// right strip [W + mx, Lx) from W on), else the owned row of f.
+const double* FusedSweep::param_at(size_t q, const double* f, PetscInt jw, PetscInt x) const {
   const double* fr = pwide_[q].data() + frame_.row_offset(jw);
-  double* dst = param_row(q, jw);
-  if (!frame_.owned_row(jw)) {
-    std::memcpy(dst + c0, fr + c0, sizeof(double) * (c1 - c0));
-    return;
-  }
   const PetscInt W = frame_.width(), mx = grid_.owned().m[0];
-  const PetscInt a = std::clamp(W, c0, c1), b = std::clamp(W + mx, a, c1);
-  std::memcpy(dst + c0, fr + c0, sizeof(double) * (a - c0));                   // left strip
-  std::memcpy(dst + a, f + (jw - W) * mx + (a - W), sizeof(double) * (b - a)); // owned
-  std::memcpy(dst + b, fr + W + (b - W - mx), sizeof(double) * (c1 - b));      // right strip
+  if (!frame_.owned_row(jw) || x < W) return fr + x;
+  if (x >= W + mx) return fr + (x - mx);
+  return f + (jw - W) * mx + (x - W);
 }
 
 // Row jw of the input box for step 1, as two bases indexed by box column x: `edge` for the
@@ -176,6 +169,9 @@ void FusedSweep::sweep_tile(const std::vector<const double*>& in, const std::vec
   std::vector<double*> dst(ns_);
   std::vector<size_t> slot(static_cast<size_t>(nr));
   const size_t np = pwide_.size();
+  bool any_field = false;
+  for (size_t q = 0; q < np; ++q)
+    any_field = any_field || pfield_[q];
   std::vector<const double*> prow(np);
   row.prow = prow.data();
   row.src = src.data();
@@ -183,7 +179,7 @@ void FusedSweep::sweep_tile(const std::vector<const double*>& in, const std::vec
   row.wclass = nullptr;
   auto margin = [&](int l) { return W - static_cast<PetscInt>(n - l) * r_; };
   // Box columns [x0, x1) of row jl of step l; step 1 reads the input rows' `edge` or `mid` base.
-  auto sweep_row = [&](int l, PetscInt jl, PetscInt x0, PetscInt x1, bool mid) {
+  auto sweep_piece = [&](int l, PetscInt jl, PetscInt x0, PetscInt x1, bool mid) {
     if (x1 <= x0) return;
     for (int s = 0; s < ns_; ++s) {
       const double* base = l == 1 ? nullptr : ring_row(l - 1, s, 0);
@@ -198,16 +194,22 @@ void FusedSweep::sweep_tile(const std::vector<const double*>& in, const std::vec
                x0;
     }
     for (size_t q = 0; q < np; ++q)
-      prow[q] = (pfield_[q] ? param_row(q, jl) : pwide_[q].data()) + x0;
+      prow[q] = pfield_[q] ? param_at(q, pf[q], jl, x0) : pwide_[q].data() + x0;
     row.n = static_cast<int>(x1 - x0);
     fn(row);
+  };
+  // The same, split where the parameter fields' rows change base (the owned columns' edges).
+  auto sweep_row = [&](int l, PetscInt jl, PetscInt x0, PetscInt x1, bool mid) {
+    if (!any_field || !frame_.owned_row(jl)) return sweep_piece(l, jl, x0, x1, mid);
+    const PetscInt a = std::clamp(W, x0, x1), b = std::clamp(W + mx, a, x1);
+    sweep_piece(l, jl, x0, a, mid);
+    sweep_piece(l, jl, a, b, mid);
+    sweep_piece(l, jl, b, x1, mid);
   };
   const PetscInt e0 = margin(0);
   for (PetscInt jw = e0; jw < ly - e0; ++jw) {
     for (int s = 0; s < ns_; ++s)
       in0_[s][jw % ring_] = input_row(in, s, jw, left);
-    for (size_t q = 0; q < np; ++q) // the columns step 1 computes (later steps compute fewer)
-      if (pfield_[q]) load_param_row(q, pf[q], jw, t0 - (n - 1), t1 + (n - 1));
     for (int l = 1; l <= n; ++l) {
       const PetscInt jl = jw - static_cast<PetscInt>(l) * r_, e = margin(l);
       if (jl < e || jl >= ly - e) continue;

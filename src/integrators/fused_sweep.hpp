@@ -18,9 +18,10 @@
 // overwritten, are saved: per tile after the first, its n columns left of it of every owned row,
 // copied once at the start of the pass (no second state set).
 // Per-cell parameters (field mode): each field's frame is filled once (set_params; the fields must
-// not change afterwards) and each scalar copied into a row of Lx values; per pass, each row of a
-// field is assembled once (frame strips and the owned row) into a ring of depth r + 1 rows read
-// by every step (no copy of a field over the whole box).
+// not change afterwards) and each scalar copied into a row of Lx values (read only by kernels
+// that take every parameter as a row). A step reads a field's row where it lies: a frame row,
+// or on an owned row the frame's strips and the field's own vector, a row call split at the
+// owned columns' edges (no copy of a field, per pass or over the box).
 #pragma once
 
 #include "fields/param_set.hpp"
@@ -73,12 +74,9 @@ private:
   };
   InputRow input_row(const std::vector<const double*>& in, int s, PetscInt jw,
                      const LeftStrip& left) const;
-  double* param_row(size_t q, PetscInt jw) const {
-    const size_t slot = static_cast<size_t>(jw % pslots_);
-    return pring_buf_.data() + (q * static_cast<size_t>(pslots_) + slot) * stride_;
-  }
-  // Box columns [c0, c1) of row jw of parameter field q (owned values f) into param_row(q, jw).
-  void load_param_row(size_t q, const double* f, PetscInt jw, PetscInt c0, PetscInt c1) const;
+  // Row jw of parameter field q (owned values f) from box column x on, valid to the end of x's
+  // piece: [0, W), [W, W + mx) or [W + mx, Lx) on an owned row, the whole row on a frame row.
+  const double* param_at(size_t q, const double* f, PetscInt jw, PetscInt x) const;
   LeftStrip save_left_strip(const std::vector<const double*>& in, int n, PetscInt t0,
                             size_t tile) const;
   static constexpr double kTileBytes = 1024.0 * 1024; // ring rows of one tile: half an L2
@@ -102,8 +100,6 @@ private:
   const ParamSet* params_ = nullptr;                   // field mode
   std::vector<std::vector<double>> pwide_; // per parameter: a scalar's row of Lx, a field's frame
   std::vector<bool> pfield_;               // parameter q is a field
-  PetscInt pslots_ = 1;                    // rows per field in the parameter ring: depth r + 1
-  mutable std::vector<double> pring_buf_;  // [parameter][slot][stride]
 };
 
 } // namespace morphogen

@@ -1,5 +1,7 @@
 // The kernels instantiated from one reaction model: the fused explicit row sweep for each
-// stencil row layout and for scalar or per-cell parameters, the general explicit path's update
+// stencil row layout and each form of the parameters (which of them are per-cell rows: every
+// subset of the first kParamMaskBits parameters; a model with more parameters has two forms,
+// all scalars or all rows), the general explicit path's update
 // (diffusion precomputed) and the split integrator's per-cell reaction substep (the lockstep
 // Newton of reaction_lockstep_kernel.hpp). Each model's
 // explicit and reaction rows are instantiated in their own translation units
@@ -15,6 +17,7 @@
 
 #include <functional>
 #include <stdexcept>
+#include <utility>
 
 namespace morphogen {
 
@@ -28,16 +31,22 @@ constexpr int kRowLayouts = 4;
 // A model built at run time (models/runtime_model.hpp) has no fused kernels (fused = false:
 // the explicit integrator takes its general path) and generic pre/reaction rows that call its
 // kinetics (integrators/runtime_kernels.hpp).
+// Fused row kernels per parameter form: bit q of the index says parameter q is a row.
+constexpr int kParamMaskBits = 3;
+constexpr unsigned kParamMasks = 1u << kParamMaskBits;
+
 struct ModelKernels {
   bool fused = true;
-  // [wide][field_params][layout]; wide: the same rows compiled with 512-bit vectors
-  ExplicitRowFn explicit_row[2][2][kRowLayouts] = {};
+  // [wide][parameter mask][layout]; wide: the same rows compiled with 512-bit vectors
+  ExplicitRowFn explicit_row[2][kParamMasks][kRowLayouts] = {};
   std::function<void(const ExplicitRow&)> explicit_pre[2]; // [field_params]
   ReactionRowFn reaction_row[2];                           // [field_params]
 
-  // The fused kernel of a row stencil; throws std::logic_error for a layout without one
-  // (callers check the stencil first: there are no null entries to call).
-  ExplicitRowFn row_kernel(bool field_params, int nrows, bool box, bool wide = false) const {
+  // The fused kernel of a row stencil for the parameters whose bits field_mask sets (bit q:
+  // parameter q varies per cell, ParamSet::field_mask; 0: all scalars); throws
+  // std::logic_error for a layout without one (callers check the stencil first: there are no
+  // null entries to call).
+  ExplicitRowFn row_kernel(unsigned field_mask, int nrows, bool box, bool wide = false) const {
     const int idx = !box && nrows == 3   ? 0
                     : !box && nrows == 5 ? 1
                     : box && nrows == 3  ? 2
@@ -45,23 +54,39 @@ struct ModelKernels {
                                          : -1;
     if (idx < 0 || !fused)
       throw std::logic_error("no fused explicit kernel for this stencil layout");
-    return explicit_row[wide ? 1 : 0][field_params ? 1 : 0][idx];
+    const unsigned m = field_mask < kParamMasks ? field_mask : kParamMasks - 1;
+    return explicit_row[wide ? 1 : 0][m][idx];
   }
 };
 
 // The explicit rows (integrators/kernels/<model>.cpp, no FMA contraction; the Wide copies in
 // <model>_wide.cpp, compiled with 512-bit vectors) and the reaction rows
 // (integrators/kernels/<model>_reaction.cpp, contracted: see CMakeLists.txt) of model M.
+// The parameter form of table entry Mask for model M: the mask itself where the model has at
+// most kParamMaskBits parameters (bits beyond them dropped: one instantiation per form), else
+// all scalars (0) or all rows.
+template <class M, unsigned Mask> constexpr ParamRows param_form() {
+  if constexpr (M::nparams <= kParamMaskBits)
+    return ParamRows{Mask & ((1u << M::nparams) - 1u)};
+  else
+    return Mask == 0 ? kScalarParams : kAllParamRows;
+}
+
+template <class M, bool Wide, unsigned Mask>
+void explicit_row_layouts(ExplicitRowFn (&r)[kRowLayouts]) {
+  constexpr ParamRows PR = param_form<M, Mask>();
+  r[0] = &explicit_row<M, 3, false, PR, Wide>;
+  r[1] = &explicit_row<M, 5, false, PR, Wide>;
+  r[2] = &explicit_row<M, 3, true, PR, Wide>;
+  r[3] = &explicit_row<M, 9, true, PR, Wide>;
+}
+
 template <class M, bool Wide> void explicit_row_kernels(ModelKernels& k) {
-  ExplicitRowFn(&r)[2][kRowLayouts] = k.explicit_row[Wide ? 1 : 0];
-  r[0][0] = &explicit_row<M, 3, false, false, Wide>;
-  r[0][1] = &explicit_row<M, 5, false, false, Wide>;
-  r[0][2] = &explicit_row<M, 3, true, false, Wide>;
-  r[0][3] = &explicit_row<M, 9, true, false, Wide>;
-  r[1][0] = &explicit_row<M, 3, false, true, Wide>;
-  r[1][1] = &explicit_row<M, 5, false, true, Wide>;
-  r[1][2] = &explicit_row<M, 3, true, true, Wide>;
-  r[1][3] = &explicit_row<M, 9, true, true, Wide>;
+  ExplicitRowFn(&r)[kParamMasks][kRowLayouts] = k.explicit_row[Wide ? 1 : 0];
+  [&r]<unsigned... Mask>(std::integer_sequence<unsigned, Mask...>) {
+    (explicit_row_layouts<M, Wide, Mask>(r[Mask]), ...);
+  }
+  (std::make_integer_sequence<unsigned, kParamMasks>{});
 }
 
 template <class M> void explicit_kernels(ModelKernels& k) {

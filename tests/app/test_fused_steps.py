@@ -3,7 +3,8 @@
 progress lines falling inside would-be passes (no summary: its samples every 1/1000 of a run
 would end every pass of so short a run), and a step count that is no multiple of k, writes the same
 bytes in every HDF5 dataset and PNG as the same run with k = 1; an unsupported configuration
-(zero-flux boundaries) runs one step per pass with a log line saying why."""
+(zero-flux boundaries) runs one step per pass with a log line saying why. Parameter fields of
+one value give the scalars' bits in every parameter form of the row kernels."""
 import glob
 import os
 import re
@@ -79,3 +80,37 @@ def test_default_fuses_large_states_in_place(tmp_path):
     p = run([DECK, "-grid_n", "64,64", "-steps", "10", "-summary", "false"], tmp_path, ranks=2)
     assert p.returncode == 0, p.stderr
     assert "fuse" not in p.stdout
+
+
+# Each parameter form of the row kernels (which parameters are per-cell rows, the others
+# scalars kept in registers): a field of one value everywhere gives the bits of the scalar, for
+# every subset of Turing's three parameters, in one-step passes (64^2) and in fused in-place
+# passes that read the fields' rows where they lie (2048x512 on 2 ranks: the default fuses).
+CONSTANT_FIELDS = {"alpha": "12 + 0*x", "beta": "16 + 0*y", "s": "1/128 + 0*x"}
+
+
+def species(path):
+    with h5py.File(path, "r") as f:
+        return {s: f["VTKHDF/PointData/" + s][()] for s in ("a", "b")}
+
+
+@pytest.mark.parametrize("grid,ranks", [("64,64", 1), ("2048,512", 2)])
+def test_constant_fields_give_the_scalar_bits(tmp_path, grid, ranks):
+    args = [DECK, "-grid_n", grid, "-steps", "24", "-summary", "false", "-png_every", "0",
+            "-progress_every", "1000", "-params_alpha", "12", "-params_beta", "16",
+            "-params_s", "1/128", "-init_a", "4 + 0.1*sin(0.3*x)*cos(0.2*y)"]
+    subsets = [(), ("alpha",), ("beta",), ("s",), ("alpha", "beta"), ("beta", "s"),
+               ("alpha", "beta", "s")]
+    results = []
+    for sub in subsets:
+        extra = []
+        for name in sub:
+            extra += ["-params_" + name, CONSTANT_FIELDS[name]]
+        out = "p_" + ("_".join(sub) or "scalar")
+        p = run(args + extra + ["-output_dir", out], tmp_path, ranks=ranks)
+        assert p.returncode == 0, p.stderr
+        assert ("explicit_fuse_steps auto" in p.stdout) == (ranks == 2), p.stdout
+        results.append(species(str(tmp_path / out / "morphogen_0000024.vtkhdf")))
+    for sub, r in zip(subsets[1:], results[1:]):
+        for s in ("a", "b"):
+            assert r[s].tobytes() == results[0][s].tobytes(), (sub, s)

@@ -54,9 +54,9 @@ struct BoxRows {
   }
 };
 
-// Cells [i0, i0 + len) of the block's middle row through explicit_row<GS, 9, true, FP>: by
+// Cells [i0, i0 + len) of the block's middle row through explicit_row<GS, 9, true, PR>: by
 // class (rows in classes.perm order) or by the general row form.
-template <bool FP>
+template <ParamRows PR>
 void run_row(const Block& b, const BoxRows& st, bool by_class, const double* p, int i0, int len,
              std::vector<double> (&out)[2]) {
   const double* src[18];
@@ -89,7 +89,7 @@ void run_row(const Block& b, const BoxRows& st, bool by_class, const double* p, 
   a.dt = 0.01;
   a.dst = dst;
   a.wclass = by_class ? st.classes.w.data() : nullptr;
-  explicit_row<GS, 9, true, FP>(a);
+  explicit_row<GS, 9, true, PR>(a);
 }
 
 double wave(int s, double x, double y, double z) {
@@ -106,7 +106,7 @@ TEST(BoxClassKernel, ExactOnAQuadraticWithTheReactionOff) {
   for (const char* name : {"19pt", "27pt"}) {
     const BoxRows st(name, b.h);
     std::vector<double> out[2];
-    run_row<false>(b, st, true, p, 0, kN, out);
+    run_row<kScalarParams>(b, st, true, p, 0, kN, out);
     for (int s = 0; s < 2; ++s)
       for (int i = 0; i < kN; ++i) {
         const double u = b.u[s][b.idx(i, 0, 0)];
@@ -122,10 +122,10 @@ TEST(BoxClassKernel, MatchesTheGeneralRowFormWithReactionAndFieldParams) {
   for (const char* name : {"19pt", "27pt"}) {
     const BoxRows st(name, b.h);
     std::vector<double> cls[2], gen[2], clsf[2], genf[2];
-    run_row<false>(b, st, true, p, 0, kN, cls);
-    run_row<false>(b, st, false, p, 0, kN, gen);
-    run_row<true>(b, st, true, p, 0, kN, clsf);
-    run_row<true>(b, st, false, p, 0, kN, genf);
+    run_row<kScalarParams>(b, st, true, p, 0, kN, cls);
+    run_row<kScalarParams>(b, st, false, p, 0, kN, gen);
+    run_row<kAllParamRows>(b, st, true, p, 0, kN, clsf);
+    run_row<kAllParamRows>(b, st, false, p, 0, kN, genf);
     double diff = 0, difff = 0, scale = 0, change = 0;
     for (int s = 0; s < 2; ++s)
       for (int i = 0; i < kN; ++i) {
@@ -149,11 +149,11 @@ TEST(BoxClassKernel, SameBitsWhateverPartOfTheRowACallCovers) {
   for (const char* name : {"19pt", "27pt"}) {
     const BoxRows st(name, b.h);
     std::vector<double> whole[2];
-    run_row<false>(b, st, true, p, 0, kN, whole);
+    run_row<kScalarParams>(b, st, true, p, 0, kN, whole);
     for (const auto& cut : splits) {
       std::vector<double> pieces[2];
       for (size_t c = 0; c + 1 < cut.size(); ++c)
-        run_row<false>(b, st, true, p, cut[c], cut[c + 1] - cut[c], pieces);
+        run_row<kScalarParams>(b, st, true, p, cut[c], cut[c + 1] - cut[c], pieces);
       for (int s = 0; s < 2; ++s)
         for (int i = 0; i < kN; ++i)
           ASSERT_EQ(whole[s][i], pieces[s][i])

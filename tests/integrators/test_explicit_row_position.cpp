@@ -1,16 +1,20 @@
 // The fused explicit row kernels as the integrator runs them (integrators/model_kernels.hpp:
 // each model's table, compiled as the library is) give every cell the same bits wherever it
 // lies in the row passed to them: for every compiled model, every row layout (5pt, 7pt, 9pt, the
-// 9-row box stencils by weight class and by 27 taps), scalar and per-cell parameters, a row of
+// 9-row box stencils by weight class and by 27 taps), every parameter form of the table (which
+// parameters are per-cell rows, the rest scalars), a row of
 // 83 cells is swept whole and as every sub-row [i0, i0 + n) with i0 < 17 (so each cell is once
 // in a vector body and once in a loop remainder, for 256- and 512-bit vectors). A rank's rows
 // and a fused pass's tiles are such sub-rows, so this is what keeps explicit results
 // independent of the decomposition and of -explicit_fuse_steps bit for bit. Both compiles of
 // the table (256- and 512-bit vectors, -explicit_vector_width) are swept, every entry is set,
-// and the wide compile gives the narrow one's bits on every sub-row.
+// and the wide compile gives the narrow one's bits on every sub-row. Each form also gives the
+// bits of the all-rows kernel fed its scalars as rows of one value (a scalar kept in a register
+// is the same number as a row of it).
 #include "../model_typed_tests.hpp"
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -77,11 +81,20 @@ void sweep(ExplicitRowFn fn, const Rows& rows, const double* w, const double* wc
   a.wclass = wclass;
   a.D = D;
   a.floor = floor;
-  a.prow = field ? prow.data() : nullptr;
+  a.prow = field ? prow.data() : nullptr; // a kernel of scalars reads no row
   a.pconst = pdef;
   a.dt = 0.05;
   a.dst = dst.data();
   fn(a);
+}
+
+// The kernel that reads every parameter as a row, instantiated here (not from the table).
+template <class M> ExplicitRowFn all_rows_kernel(int nr, bool box) {
+  if (nr == 3)
+    return box ? &explicit_row<M, 3, true, kAllParamRows>
+               : &explicit_row<M, 3, false, kAllParamRows>;
+  if (nr == 5) return &explicit_row<M, 5, false, kAllParamRows>;
+  return &explicit_row<M, 9, true, kAllParamRows>;
 }
 
 TYPED_TEST(ExplicitRowPosition, EveryCellTheSameBitsWhereverItLiesInTheRow) {
@@ -100,17 +113,21 @@ TYPED_TEST(ExplicitRowPosition, EveryCellTheSameBitsWhereverItLiesInTheRow) {
   };
   for (const Layout& L : {Layout{3, false, false}, Layout{5, false, false}, Layout{3, true, false},
                           Layout{9, true, false}, Layout{9, true, true}})
-    for (bool field : {false, true}) {
+    for (unsigned mask = 0; mask < kParamMasks; ++mask) {
       SCOPED_TRACE(std::to_string(L.nr) + (L.box ? " box" : " star") +
-                   (L.classes ? " by class" : "") + (field ? " field" : " scalar"));
-      const Rows rows(NS, L.nr, NP, init, pdef);
+                   (L.classes ? " by class" : "") + " parameter mask " + std::to_string(mask));
+      const bool field = mask != 0;
+      Rows rows(NS, L.nr, NP, init, pdef);
+      for (int q = 0; q < NP; ++q) // the parameters this form reads as scalars: rows of pdef[q]
+        if (!(NP <= kParamMaskBits ? (mask >> q & 1u) != 0 : field))
+          std::fill(rows.params[q].begin(), rows.params[q].end(), pdef[q]);
       std::vector<double> w(3 * static_cast<size_t>(L.nr));
       for (size_t t = 0; t < w.size(); ++t)
         w[t] = 0.05 + 0.01 * static_cast<double>(t % 5);
       const double wclass[4] = {-2.0, 0.3, 0.05, 0.01};
       const double* wc = L.classes ? wclass : nullptr;
-      const ExplicitRowFn narrow = k.row_kernel(field, L.nr, L.box, false);
-      const ExplicitRowFn wide = k.row_kernel(field, L.nr, L.box, true);
+      const ExplicitRowFn narrow = k.row_kernel(mask, L.nr, L.box, false);
+      const ExplicitRowFn wide = k.row_kernel(mask, L.nr, L.box, true);
       ASSERT_NE(narrow, nullptr);
       ASSERT_NE(wide, nullptr);
       // Two compiles where the build has 512-bit vectors; the same code otherwise.
@@ -119,6 +136,11 @@ TYPED_TEST(ExplicitRowPosition, EveryCellTheSameBitsWhereverItLiesInTheRow) {
       }
       std::vector<std::vector<double>> whole(NS, std::vector<double>(kN));
       sweep<M>(narrow, rows, w.data(), wc, pdef, field, 0, kN, whole);
+      std::vector<std::vector<double>> all_rows(NS, std::vector<double>(kN));
+      sweep<M>(all_rows_kernel<M>(L.nr, L.box), rows, w.data(), wc, pdef, true, 0, kN, all_rows);
+      for (int s = 0; s < NS; ++s)
+        EXPECT_EQ(std::memcmp(whole[s].data(), all_rows[s].data(), sizeof(double) * kN), 0)
+            << "species " << s << ": the parameter form changes the bits";
       long differ = 0, differ_wide = 0;
       for (const ExplicitRowFn fn : {narrow, wide})
         for (int i0 = 0; i0 < 17; ++i0)

@@ -75,7 +75,7 @@ TEST(KernelsWithoutPetsc, ExplicitRowOnALinearProfile) {
   a.pconst = p;
   a.dt = 0.25;
   a.dst = dst;
-  explicit_row<Schnakenberg, 1, false, false>(a);
+  explicit_row<Schnakenberg, 1, false, kScalarParams>(a);
   for (int i = 0; i < n; ++i) {
     EXPECT_DOUBLE_EQ(ou[i + 1], 0.75 * i) << i;
     EXPECT_DOUBLE_EQ(ov[i + 1], 0.0) << i;
