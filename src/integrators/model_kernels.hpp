@@ -28,13 +28,13 @@ using ExplicitRowFn = void (*)(const ExplicitRow&);
 enum class RowLayout { Star3 = 0, Star5 = 1, Box3 = 2, Box9 = 3 };
 constexpr int kRowLayouts = 4;
 
-// A model built at run time (models/runtime_model.hpp) has no fused kernels (fused = false:
-// the explicit integrator takes its general path) and generic pre/reaction rows that call its
-// kinetics (integrators/runtime_kernels.hpp).
 // Fused row kernels per parameter form: bit q of the index says parameter q is a row.
 constexpr int kParamMaskBits = 3;
 constexpr unsigned kParamMasks = 1u << kParamMaskBits;
 
+// A model built at run time (models/runtime_model.hpp) has no fused kernels (fused = false:
+// the explicit integrator takes its general path) and generic pre/reaction rows that call its
+// kinetics (integrators/runtime_kernels.hpp).
 struct ModelKernels {
   bool fused = true;
   // [wide][parameter mask][layout]; wide: the same rows compiled with 512-bit vectors
@@ -59,9 +59,6 @@ struct ModelKernels {
   }
 };
 
-// The explicit rows (integrators/kernels/<model>.cpp, no FMA contraction; the Wide copies in
-// <model>_wide.cpp, compiled with 512-bit vectors) and the reaction rows
-// (integrators/kernels/<model>_reaction.cpp, contracted: see CMakeLists.txt) of model M.
 // The parameter form of table entry Mask for model M: the mask itself where the model has at
 // most kParamMaskBits parameters (bits beyond them dropped: one instantiation per form), else
 // all scalars (0) or all rows.
@@ -72,6 +69,9 @@ template <class M, unsigned Mask> constexpr ParamRows param_form() {
     return Mask == 0 ? kScalarParams : kAllParamRows;
 }
 
+// The explicit rows (integrators/kernels/<model>.cpp, no FMA contraction; the Wide copies in
+// <model>_wide.cpp, compiled with 512-bit vectors) and the reaction rows
+// (integrators/kernels/<model>_reaction.cpp, contracted: see CMakeLists.txt) of model M.
 template <class M, bool Wide, unsigned Mask>
 void explicit_row_layouts(ExplicitRowFn (&r)[kRowLayouts]) {
   constexpr ParamRows PR = param_form<M, Mask>();
