@@ -20,7 +20,8 @@ Each code is timed at two step counts N1 and N2 = N1 + N (N of about `--updates`
 best of `--repeat` runs each), so start-up, OpenCL compilation, set-up and final output cancel:
 rate = cells (N2 - N1) / (t(N2) - t(N1)). Prints one line per case with both rates in
 Mcell-updates/s, their ratio and the target (morphogen >= 1.3 x Ready); --json writes them.
-Ready is not a dependency of morphogen: this script only needs its `rdy` binary by path.
+Ready is not a dependency of morphogen: this script only needs its `rdy` binary by path
+(tools/build_ready.sh builds one from a Ready checkout on Debian 12).
 Exit codes: 0 done, 2 bad arguments or a run that failed (one line naming it).
 """
 import argparse

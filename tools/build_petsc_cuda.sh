@@ -19,11 +19,12 @@ fi
 apt-get install -y -qq libopenmpi-dev liblapack-dev libblas-dev libhdf5-openmpi-dev python3 \
   make >/dev/null
 mkdir -p "$work" && cd "$work"
-[ -f petsc_*.dsc ] || apt-get source -qq --download-only petsc
-src=$(ls -d petsc-3.18*/ 2>/dev/null | head -1 || true)
+compgen -G 'petsc_*.dsc' >/dev/null || apt-get source -qq --download-only petsc
+first_source_dir() { find . -maxdepth 1 -type d -name 'petsc-3.18*' -printf '%f/\n' | sort | head -1; }
+src=$(first_source_dir)
 if [ -z "$src" ]; then
   tar -xf petsc_*.orig.tar.xz
-  src=$(ls -d petsc-3.18*/ | head -1)
+  src=$(first_source_dir)
 fi
 cd "$src"
 # PETSc 3.18 supports CUDA up to 11.8 (its configure refuses newer ones): its aijcusparse uses
