@@ -14,11 +14,7 @@ struct ParamSet {
   std::vector<std::string> names;
   std::vector<double> scalar; // the value for a constant parameter
   std::vector<VecH> field;    // non-null for a spatially varying parameter
-  bool any_field() const {
-    for (const auto& f : field)
-      if (f.get()) return true;
-    return false;
-  }
+  bool any_field() const { return field_mask() != 0; }
   // Bit q set where parameter q is a field (parameters from the 32nd on: bit 31).
   unsigned field_mask() const {
     unsigned m = 0;

@@ -169,9 +169,7 @@ void FusedSweep::sweep_tile(const std::vector<const double*>& in, const std::vec
   std::vector<double*> dst(ns_);
   std::vector<size_t> slot(static_cast<size_t>(nr));
   const size_t np = pwide_.size();
-  bool any_field = false;
-  for (size_t q = 0; q < np; ++q)
-    any_field = any_field || pfield_[q];
+  const bool any_field = std::find(pfield_.begin(), pfield_.end(), true) != pfield_.end();
   std::vector<const double*> prow(np);
   row.prow = prow.data();
   row.src = src.data();
