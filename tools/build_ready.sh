@@ -9,6 +9,8 @@
 # vtkThreshold::ThresholdByUpper (the same filter set by SetLowerThreshold + THRESHOLD_UPPER),
 # and ParaView's VTK has no ImagingStencil module, used only to voxelise a mesh into an image
 # (that function now throws). Then: postproc/vs_ready.py --rdy BUILD_DIR/build/rdy
+# PoCL, once installed, is loaded into Open MPI's mpiexec by hwloc's OpenCL plugin and takes
+# SIGUSR1 from it: signal such an mpiexec with HWLOC_COMPONENTS=-opencl,-gl set (README).
 set -euo pipefail
 src=${1:?usage: tools/build_ready.sh READY_SOURCE_DIR [BUILD_DIR]}
 work=${2:-/tmp/ready-rdy}
