@@ -130,7 +130,7 @@ RowKernelRate time_row_kernel(MPI_Comm comm, const std::string& stencil, int dim
   const RowStencil rows = row_stencil(stencil, dim);
   // The box stencils' weight-class form where the explicit integrator takes it.
   BoxClasses classes;
-  const bool by_class = rows.nrows == 9 && box_classes(rows, classes);
+  const bool by_class = box_classes(rows, classes);
   int order[9] = {0, 1, 2, 3, 4, 5, 6, 7, 8};
   if (by_class) std::copy(classes.perm.begin(), classes.perm.end(), order);
   KernelRows buf(n);
@@ -158,9 +158,12 @@ RowKernelRate time_row_kernel(MPI_Comm comm, const std::string& stencil, int dim
 }
 
 double time_fused_ring(MPI_Comm comm, const std::string& stencil, int n, int levels) {
-  const RowStencil rows = row_stencil(stencil, 2);
+  RowStencil rows = row_stencil(stencil, 2);
+  BoxClasses classes; // the box stencil's weight-class form, as the fused sweep runs it
+  const bool by_class = to_class_order(rows, classes);
   const GrayScottRow gs;
-  const ExplicitRow row = gray_scott_row(gs, rows, n);
+  ExplicitRow row = gray_scott_row(gs, rows, n);
+  row.wclass = by_class ? classes.w.data() : nullptr;
   const ModelKernels k = model_kernels<models::GrayScott>();
   const long nrows = std::max<long>(1, (1L << 22) / (static_cast<long>(n) * levels));
   double ns = 1e30;

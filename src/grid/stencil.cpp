@@ -72,11 +72,12 @@ bool to_rows(const Stencil& s, RowStencil& out) {
 }
 
 bool box_classes(const RowStencil& rows, BoxClasses& out) {
-  if (rows.nrows != 9 || !rows.box || rows.off[0][0] != 0 || rows.off[0][1] != 0) return false;
+  const int n = rows.nrows; // 3: 2-D (dz = 0), 9: 3-D
+  if ((n != 3 && n != 9) || !rows.box || rows.off[0][0] != 0 || rows.off[0][1] != 0) return false;
   BoxClasses c;
   std::array<bool, 4> seen{};
   int faces = 0, corners = 0, covered = 0; // covered: bit per (dy, dz) of the 3x3 rows
-  for (int r = 0; r < 9; ++r) {
+  for (int r = 0; r < n; ++r) {
     const int dy = rows.off[r][0], dz = rows.off[r][1];
     if (dy < -1 || dy > 1 || dz < -1 || dz > 1) return false;
     covered |= 1 << (3 * (dz + 1) + dy + 1);
@@ -91,8 +92,22 @@ bool box_classes(const RowStencil& rows, BoxClasses& out) {
       c.w[k] = w;
     }
   }
-  if (covered != 0x1ff || faces != 4 || corners != 4) return false;
+  const bool whole = n == 9 ? covered == 0x1ff && faces == 4 && corners == 4
+                            : covered == 0x38 && faces == 2; // the rows dz = 0, dy = -1, 0, 1
+  if (!whole) return false;
   out = c;
+  return true;
+}
+
+bool to_class_order(RowStencil& rows, BoxClasses& out) {
+  if (!box_classes(rows, out)) return false;
+  const RowStencil given = rows;
+  for (int q = 0; q < rows.nrows; ++q) {
+    const int g = out.perm[q];
+    rows.off[q] = given.off[g];
+    for (int c = 0; c < 3; ++c)
+      rows.w[3 * q + c] = given.w[3 * g + c];
+  }
   return true;
 }
 

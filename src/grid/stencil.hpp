@@ -66,19 +66,23 @@ struct RowStencil {
   std::array<double, 27> w{}; // w[3*r + (dx+1)]
 };
 
-// A 9-row (3-D) box stencil by weight class, the form of the explicit kernel's fast box path:
-// the weight of a tap depends only on how many of its offsets (dx, dy, dz) are non-zero
-// (0: centre, 1: face, 2: edge, 3: corner), as for the isotropic 19pt and 27pt stencils.
-// perm lists the RowStencil's rows in class order: the centre row (dy = dz = 0), the 4 face
-// rows (one of dy, dz non-zero), then the 4 corner rows (both non-zero).
+// A box stencil by weight class, the form of the explicit kernel's fast box path: the weight of
+// a tap depends only on how many of its offsets (dx, dy, dz) are non-zero (0: centre, 1: face,
+// 2: edge, 3: corner), as for the isotropic 9pt (2-D: its diagonal taps are the edge class, no
+// corner class), 19pt and 27pt stencils. perm lists the RowStencil's rows in class order: the
+// centre row (dy = dz = 0), the face rows (one of dy, dz non-zero: 4 in 3-D, 2 in 2-D), then in
+// 3-D the 4 corner rows (both non-zero).
 struct BoxClasses {
-  std::array<double, 4> w{}; // centre, face, edge, corner weight
-  std::array<int, 9> perm{}; // rows in class order
+  std::array<double, 4> w{}; // centre, face, edge, corner weight (2-D: corner 0)
+  std::array<int, 9> perm{}; // rows in class order (2-D: the first 3)
 };
 
-// True (out filled) when `rows` is a 9-row box stencil whose 27 taps have one weight per class
-// (exactly equal values); false (out untouched) otherwise.
+// True (out filled) when `rows` is a 3-row (2-D) or 9-row (3-D) box stencil with every row of
+// its 3x1 or 3x3 block whose taps have one weight per class (exactly equal values); false (out
+// untouched) otherwise.
 bool box_classes(const RowStencil& rows, BoxClasses& out);
+// box_classes, and where it holds `rows` reordered into class order (out.perm applied).
+bool to_class_order(RowStencil& rows, BoxClasses& out);
 
 // True for the isotropic box stencils (9pt, 19pt, 27pt): equal spacings, no tensor or map form.
 inline bool isotropic_box(const Stencil& s) {

@@ -1,5 +1,6 @@
-// The diffusion part of the 3-D box stencils' weight-class kernel (explicit_kernel.hpp,
-// explicit_row_box_classes) along one row (pure kernel: no PETSc, MPI, allocation).
+// The diffusion part of the box stencils' weight-class kernel (explicit_kernel.hpp,
+// explicit_row_box_classes) along one row (pure kernel: no PETSc, MPI, allocation): NR = 9 rows
+// (3-D: 19pt, 27pt) or NR = 3 rows (2-D: 9pt).
 #pragma once
 
 #include <cmath>
@@ -10,34 +11,42 @@
 
 namespace morphogen {
 
-// For x = x0 .. x0 + len - 1 of one species' 9 rows in class order (w: centre, face, edge,
+// For x = x0 .. x0 + len - 1 of one species' rows in class order (w: centre, face, edge,
 // corner weight), A being the centre row:
-//   B = (f1 + f2) + (f3 + f4)        (the 4 face rows)
-//   C = (k1 + k2) + (k3 + k4)        (the 4 corner rows)
-//   q(x) = (w_c A + w_f B) + w_e C   (the taps at dx = 0)
-//   p(x) = (w_f A + w_e B) + w_k C   (the taps at dx = -1, +1; w_k C left out if !Corners)
+//   B = (f1 + f2) + (f3 + f4)        (the 4 face rows; 2-D: B = f1 + f2)
+//   C = (k1 + k2) + (k3 + k4)        (the 4 corner rows; 2-D: none)
+//   q(x) = (w_c A + w_f B) + w_e C   (the taps at dx = 0; 2-D: without w_e C)
+//   p(x) = (w_f A + w_e B) + w_k C   (the taps at dx = -1, +1; w_k C left out if !Corners or 2-D)
 //   d(x) = q(x) + (p(x - 1) + p(x + 1))
-// (each sum of products a chain of std::fma from the left). box_row_profile evaluates p and q
+// (each sum of products a chain of std::fma from the left). In 2-D the taps with two non-zero
+// offsets, the 9pt stencil's corners, are the "edge" class. box_row_profile evaluates p and q
 // at one x; box_row_diffusion_cells d cell by cell (each profile once, the last three kept).
-template <bool Corners>
+template <int NR, bool Corners>
 inline void box_row_profile(const double* const* rows, const double* w, int x, double& p,
                             double& q) {
+  static_assert(NR == 3 || NR == 9, "box rows: 3 (2-D) or 9 (3-D)");
   const double A = rows[0][x];
-  const double B = (rows[1][x] + rows[2][x]) + (rows[3][x] + rows[4][x]);
-  const double C = (rows[5][x] + rows[6][x]) + (rows[7][x] + rows[8][x]);
-  q = std::fma(w[2], C, std::fma(w[1], B, w[0] * A));
-  p = Corners ? std::fma(w[3], C, std::fma(w[2], B, w[1] * A)) : std::fma(w[2], B, w[1] * A);
+  if constexpr (NR == 3) {
+    const double B = rows[1][x] + rows[2][x];
+    q = std::fma(w[1], B, w[0] * A);
+    p = std::fma(w[2], B, w[1] * A);
+  } else {
+    const double B = (rows[1][x] + rows[2][x]) + (rows[3][x] + rows[4][x]);
+    const double C = (rows[5][x] + rows[6][x]) + (rows[7][x] + rows[8][x]);
+    q = std::fma(w[2], C, std::fma(w[1], B, w[0] * A));
+    p = Corners ? std::fma(w[3], C, std::fma(w[2], B, w[1] * A)) : std::fma(w[2], B, w[1] * A);
+  }
 }
 
-template <bool Corners>
+template <int NR, bool Corners>
 inline void box_row_diffusion_cells(const double* const* rows, const double* w, int x0, int len,
                                     double* __restrict__ d) {
   if (len <= 0) return;
   double pl, ql, pc, qc, pr, qr;
-  box_row_profile<Corners>(rows, w, x0 - 1, pl, ql);
-  box_row_profile<Corners>(rows, w, x0, pc, qc);
+  box_row_profile<NR, Corners>(rows, w, x0 - 1, pl, ql);
+  box_row_profile<NR, Corners>(rows, w, x0, pc, qc);
   for (int t = 0; t < len; ++t) {
-    box_row_profile<Corners>(rows, w, x0 + t + 1, pr, qr);
+    box_row_profile<NR, Corners>(rows, w, x0 + t + 1, pr, qr);
     d[t] = qc + (pl + pr);
     pl = pc;
     pc = pr;
@@ -107,20 +116,40 @@ template <int L> struct BoxLanes {
     else
       return __builtin_shuffle(a, b, I{1, 2, 3, 6});
   }
-  template <bool Corners>
+  template <int NR, bool Corners>
   static void profile(const double* const* rows, const V* w, int x, V& p, V& q) {
     const V A = load(rows[0] + x);
-    const V B = (load(rows[1] + x) + load(rows[2] + x)) + (load(rows[3] + x) + load(rows[4] + x));
-    const V C = (load(rows[5] + x) + load(rows[6] + x)) + (load(rows[7] + x) + load(rows[8] + x));
-    q = fma(w[2], C, fma(w[1], B, w[0] * A));
-    p = Corners ? fma(w[3], C, fma(w[2], B, w[1] * A)) : fma(w[2], B, w[1] * A);
+    if constexpr (NR == 3) {
+      const V B = load(rows[1] + x) + load(rows[2] + x);
+      q = fma(w[1], B, w[0] * A);
+      p = fma(w[2], B, w[1] * A);
+    } else {
+      const V B = (load(rows[1] + x) + load(rows[2] + x)) + (load(rows[3] + x) + load(rows[4] + x));
+      const V C = (load(rows[5] + x) + load(rows[6] + x)) + (load(rows[7] + x) + load(rows[8] + x));
+      q = fma(w[2], C, fma(w[1], B, w[0] * A));
+      p = Corners ? fma(w[3], C, fma(w[2], B, w[1] * A)) : fma(w[2], B, w[1] * A);
+    }
   }
 };
 #endif
 
+// The first x in [0, n) from which the lane-shift loop of box_row_diffusion, started there,
+// loads whole aligned vectors (Wide: 64 bytes, a cache line; else 32) from each of the `count`
+// rows (its loads start at x - 1), when all rows share their alignment; 0 otherwise. The cells
+// before it are computed by the same expressions (no bit changes), by the cell loop.
+template <bool Wide> inline int box_row_aligned_start(const double* const* rows, int count, int n) {
+  constexpr unsigned long bytes = Wide ? 64 : 32;
+  const unsigned long a = (reinterpret_cast<unsigned long>(rows[0]) - sizeof(double)) % bytes;
+  if (a % sizeof(double) != 0) return 0;
+  for (int q = 1; q < count; ++q)
+    if ((reinterpret_cast<unsigned long>(rows[q]) - sizeof(double)) % bytes != a) return 0;
+  const int x = static_cast<int>((bytes - a) % bytes / sizeof(double));
+  return x < n ? x : 0;
+}
+
 // d(x) of the comment above for x = x0 .. x0 + len - 1 (into d[0 .. len - 1]), reading the rows
 // at x0 - 1 .. max(x0 + len, min(xmax, x0 + len + 2 L - 2)): xmax is the last x the rows hold.
-template <bool Corners, bool Wide = false>
+template <int NR, bool Corners, bool Wide = false>
 inline void box_row_diffusion(const double* const* rows, const double* w, int x0, int len, int xmax,
                               double* __restrict__ d) {
   int t = 0;
@@ -131,9 +160,9 @@ inline void box_row_diffusion(const double* const* rows, const double* w, int x0
   if (len >= L) {
     const V wv[4] = {B::splat(w[0]), B::splat(w[1]), B::splat(w[2]), B::splat(w[3])};
     V p0, q0, p1, q1;
-    B::template profile<Corners>(rows, wv, x0 - 1, p0, q0); // x0 - 1 .. x0 + L - 2
+    B::template profile<NR, Corners>(rows, wv, x0 - 1, p0, q0); // x0 - 1 .. x0 + L - 2
     for (; t + L <= len && x0 + t + 2 * L - 2 <= xmax; t += L) {
-      B::template profile<Corners>(rows, wv, x0 + t + L - 1, p1, q1);
+      B::template profile<NR, Corners>(rows, wv, x0 + t + L - 1, p1, q1);
       const V dv = B::template shift<1>(q0, q1) + (p0 + B::template shift<2>(p0, p1));
       *reinterpret_cast<typename B::U*>(d + t) = dv;
       p0 = p1;
@@ -142,8 +171,8 @@ inline void box_row_diffusion(const double* const* rows, const double* w, int x0
     while (t < len) { // the last blocks (the last one may overlap): profiles at x - 1 and x + 1
       const int b = t + L <= len ? t : len - L;
       V pl, ql, pr, qr;
-      B::template profile<Corners>(rows, wv, x0 + b - 1, pl, ql);
-      B::template profile<Corners>(rows, wv, x0 + b + 1, pr, qr);
+      B::template profile<NR, Corners>(rows, wv, x0 + b - 1, pl, ql);
+      B::template profile<NR, Corners>(rows, wv, x0 + b + 1, pr, qr);
       *reinterpret_cast<typename B::U*>(d + b) = B::centre(ql, qr) + (pl + pr);
       t = b + L;
     }
@@ -151,7 +180,7 @@ inline void box_row_diffusion(const double* const* rows, const double* w, int x0
 #else
   (void)xmax;
 #endif
-  box_row_diffusion_cells<Corners>(rows, w, x0 + t, len - t, d + t);
+  box_row_diffusion_cells<NR, Corners>(rows, w, x0 + t, len - t, d + t);
 }
 
 } // namespace morphogen

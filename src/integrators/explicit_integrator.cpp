@@ -25,7 +25,9 @@ ExplicitIntegrator::ExplicitIntegrator(const Grid& grid, const Halo& halo, RowFn
     : grid_(grid), halo_(halo), row_fn_(row_fn), ns_(nspecies), stencil_(stencil), D_(std::move(D)),
       floor_(std::move(floor)), params_(params), dirichlet_(dirichlet) {
   to_rows(stencil_, rows_);
-  by_class_ = box_classes(rows_, classes_); // 19pt, 27pt: weight classes, rows in class order
+  // 9pt, 19pt, 27pt: weight classes, rows in class order (the form of the fused passes too, so
+  // that one step per pass and k give the same bits).
+  by_class_ = box_classes(rows_, classes_);
   ring_depth_ = static_cast<int>(reach(1) * block_rows()) + reach(0) + 1;
   ring_n_ = static_cast<size_t>(grid.owned().m[0]);
   if (params_.any_field())
@@ -402,7 +404,7 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
   // block (the kernel steps the row pointers by the ghosted row length): small grids spend less
   // on per-call setup. Same arithmetic per cell either way.
   const PetscInt pf_off = prefetch_offset(delta), pf_end = grid_.ghosted().size() - ob.m[0];
-  const bool multi = !in_place && !field_mode && !by_class_ && pf_off < 0;
+  const bool multi = !in_place && !field_mode && pf_off < 0;
   row.src_stride = row.dst_stride = gx;
   for (PetscInt jb = ob.s[1]; jb < jlast; jb += jblock) {
     const PetscInt jend = std::min(jb + jblock, jlast), bh = jend - jb, lag = rz * bh + ry;

@@ -179,7 +179,7 @@ private:
   int ns_;
   Stencil stencil_;
   RowStencil rows_;
-  BoxClasses classes_;    // 9-row box stencils by weight class (the kernel's fast form)
+  BoxClasses classes_;    // box stencils by weight class (the kernel's fast form)
   bool by_class_ = false; // rows_ has that form: rows passed in classes_.perm order
   std::vector<double> D_, floor_;
   const ParamSet& params_;

@@ -27,10 +27,11 @@
 // refuses to vectorise.) Wide = true only names a second instantiation, compiled with 512-bit
 // vectors (integrators/kernels/<model>_wide.cpp; the same arithmetic per cell, so bitwise the
 // same results): the explicit integrator picks it per sweep (-explicit_vector_width).
-// The 3-D box stencils (19pt, 27pt: 9 rows) take the weight-class path
-// explicit_row_box_classes when ExplicitRow::wclass is set (the fused driver sets it; a
-// different summation order, stated there); the 27-tap loop serves a 9-row stencil without
-// that form (slowly: GCC does not unroll its loop over 9 rows, so it does not vectorise it).
+// The isotropic box stencils (2-D 9pt: 3 rows; 3-D 19pt, 27pt: 9 rows) take the weight-class
+// path explicit_row_box_classes when ExplicitRow::wclass is set (the drivers set it; a
+// different summation order, stated there); the tap loop serves a box stencil without that
+// form (a 9-row one slowly: GCC does not unroll its loop over 9 rows, so it does not vectorise
+// it).
 #pragma once
 
 #include "fields/clamp_kernel.hpp"
@@ -51,25 +52,28 @@ struct ExplicitRow {
   double dt = 0;
   double* const* dst = nullptr;       // [nspecies] output rows
   const double* const* div = nullptr; // [nspecies] precomputed diffusion rows (general path)
-  // 9-row box stencils only: the weights by class (grid/stencil.hpp, BoxClasses: centre, face,
-  // edge, corner) with src in class order, or null for the general 27-tap form of w.
+  // Box stencils only: the weights by class (grid/stencil.hpp, BoxClasses: centre, face, edge,
+  // corner) with src in class order, or null for the general tap form of w.
   const double* wclass = nullptr;
   // Consecutive rows in one call: row j reads src[q] + j src_stride and writes
-  // dst[s] + j dst_stride. Only explicit_row with scalar parameters and without wclass reads
-  // it (the other kernels sweep one row; callers set rows = 1 for them).
+  // dst[s] + j dst_stride. Only explicit_row with scalar parameters reads it (the other
+  // kernels sweep one row; callers set rows = 1 for them).
   int rows = 1;
   long src_stride = 0, dst_stride = 0;
 };
 
-// The 9-row box stencils by weight class (19pt, 27pt; ExplicitRow::wclass set), rows in class
-// order: src[s*9] the centre row, src[s*9 + 1..4] the face rows, src[s*9 + 5..8] the corner
-// rows. Per chunk of up to kBoxChunk cells, first d of box_row_diffusion (box_row_kernel.hpp:
-// lane shifts, no loads at x -+ 1) into a stack buffer, with the class weights scaled by dt D_s,
+// The box stencils by weight class (ExplicitRow::wclass set), rows in class order: 3-D (19pt,
+// 27pt, NR = 9) src[s*9] the centre row, src[s*9 + 1..4] the face rows, src[s*9 + 5..8] the
+// corner rows; 2-D (9pt, NR = 3) src[s*3] the centre row, src[s*3 + 1..2] the face rows. Per
+// chunk of up to kBoxChunk cells, first d of box_row_diffusion (box_row_kernel.hpp: lane
+// shifts, no loads at x -+ 1) into a stack buffer, with the class weights scaled by dt D_s,
 // then per cell
 //   out_s = max( fma(dt, R_s, u_s) + d_s(i),  floor_s ).
-// Per cell and species: 9 loads, 6 adds and 4-6 multiply-adds for the profiles, 2 adds for
-// the taps, instead of 27 loads and 27 multiply-adds. Each value is one fixed expression of the
-// cell's neighbours, so neither the chunks nor the rank decomposition change a bit.
+// Per cell and species in 3-D: 9 loads, 6 adds and 4-6 multiply-adds for the profiles, 2 adds
+// for the taps, instead of 27 loads and 27 multiply-adds; in 2-D 3 loads, 1 add, 4 multiply-adds
+// and 2 adds instead of 9 loads (6 of them across cache lines) and 9 multiply-adds. Each value is
+// one fixed expression of the cell's neighbours, so neither the chunks nor the rank decomposition
+// change a bit.
 constexpr int kBoxChunk = 128;
 
 // True when some species has a finite floor (the max of the update is needed).
@@ -104,17 +108,20 @@ inline void load_params(const ExplicitRow& a, const double* __restrict__ (&prow)
   }
 }
 
-template <class M, ParamRows PR, bool Corners, bool Clamp, bool Wide = false>
+template <class M, int NR, ParamRows PR, bool Corners, bool Clamp, bool Wide = false>
 inline void explicit_row_box_classes(const ExplicitRow& a) {
   constexpr int NS = M::nspecies;
   constexpr int NP = M::nparams;
-  const double* __restrict__ src[NS];
+  const double* rows[NS * NR];        // all rows, read by box_row_diffusion
+  const double* __restrict__ src[NS]; // the centre rows
   double* __restrict__ dst[NS];
   double wc[NS][4], floor[NS], pc[NP > 0 ? NP : 1];
   const double* __restrict__ prow[NP > 0 ? NP : 1];
   const double dt = a.dt;
+  for (int q = 0; q < NS * NR; ++q)
+    rows[q] = a.src[q];
   for (int s = 0; s < NS; ++s) {
-    src[s] = a.src[s * 9];
+    src[s] = a.src[s * NR];
     dst[s] = a.dst[s];
     for (int c = 0; c < 4; ++c)
       wc[s][c] = (dt * a.D[s]) * a.wclass[c];
@@ -123,10 +130,9 @@ inline void explicit_row_box_classes(const ExplicitRow& a) {
   load_params<PR, NP>(a, prow, pc);
   const int n = a.n;
   alignas(64) double dbuf[NS][kBoxChunk];
-  for (int i0 = 0; i0 < n; i0 += kBoxChunk) {
-    const int m = n - i0 < kBoxChunk ? n - i0 : kBoxChunk;
+  auto chunk = [&](int i0, int m) { // cells i0 .. i0 + m - 1, m <= kBoxChunk
     for (int s = 0; s < NS; ++s)
-      box_row_diffusion<Corners, Wide>(a.src + s * 9, wc[s], i0, m, n, dbuf[s]);
+      box_row_diffusion<NR, Corners, Wide>(rows + s * NR, wc[s], i0, m, n, dbuf[s]);
 #pragma GCC ivdep
     for (int x = 0; x < m; ++x) {
       const int i = i0 + x;
@@ -140,6 +146,21 @@ inline void explicit_row_box_classes(const ExplicitRow& a) {
         const double v = std::fma(dt, r[s], u[s]) + dbuf[s][x];
         dst[s][i] = Clamp ? clamp_to_floor(v, floor[s]) : v;
       }
+    }
+  };
+  const int nrows = any_param_row(PR) ? 1 : a.rows;
+  for (int j = 0; j < nrows; ++j) {
+    // Chunks start where the rows' vectors are aligned (where all rows share one alignment, as
+    // a fused pass's ring rows do), after a first chunk of the cells before it.
+    const int a0 = box_row_aligned_start<Wide>(rows, NS * NR, n);
+    if (a0 > 0) chunk(0, a0);
+    for (int i0 = a0; i0 < n; i0 += kBoxChunk)
+      chunk(i0, n - i0 < kBoxChunk ? n - i0 : kBoxChunk);
+    for (int q = 0; q < NS * NR; ++q)
+      rows[q] += a.src_stride;
+    for (int s = 0; s < NS; ++s) {
+      src[s] += a.src_stride;
+      dst[s] += a.dst_stride;
     }
   }
 }
@@ -199,17 +220,26 @@ inline void explicit_row_taps(const ExplicitRow& a) {
 template <class M, int NR, bool Box, ParamRows PR, bool Wide = false>
 inline void explicit_row(const ExplicitRow& a) {
   const bool clamp = any_floor(a.floor, M::nspecies);
+  if constexpr (NR == 3 && Box) { // 2-D: no corner class (w[3] is 0)
+    if (a.wclass) {
+      if (clamp)
+        explicit_row_box_classes<M, 3, PR, false, true, Wide>(a);
+      else
+        explicit_row_box_classes<M, 3, PR, false, false, Wide>(a);
+      return;
+    }
+  }
   if constexpr (NR == 9 && Box) {
     if (a.wclass) {
       const bool corners = a.wclass[3] != 0.0;
       if (clamp && corners)
-        explicit_row_box_classes<M, PR, true, true, Wide>(a);
+        explicit_row_box_classes<M, 9, PR, true, true, Wide>(a);
       else if (clamp)
-        explicit_row_box_classes<M, PR, false, true, Wide>(a);
+        explicit_row_box_classes<M, 9, PR, false, true, Wide>(a);
       else if (corners)
-        explicit_row_box_classes<M, PR, true, false, Wide>(a);
+        explicit_row_box_classes<M, 9, PR, true, false, Wide>(a);
       else
-        explicit_row_box_classes<M, PR, false, false, Wide>(a);
+        explicit_row_box_classes<M, 9, PR, false, false, Wide>(a);
       return;
     }
   }

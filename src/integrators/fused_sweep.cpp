@@ -1,6 +1,7 @@
 #include "integrators/fused_sweep.hpp"
 
 #include "core/log_events.hpp"
+#include "core/prefetch.hpp"
 
 #include <algorithm>
 #include <cstdlib>
@@ -20,6 +21,7 @@ FusedSweep::FusedSweep(const Grid& grid, const RowStencil& rows, int nspecies, i
                        PetscInt tile)
     : grid_(grid), rows_(rows), ns_(nspecies), depth_(depth), tile_(tile), r_(radius(rows)),
       frame_(grid, depth * radius(rows)), ring_(2 * radius(rows) + 1) {
+  by_class_ = to_class_order(rows_, classes_); // 9pt: the kernel's fast form
   // Rows padded to whole cache lines, plus one line against cache-set aliasing of the ring.
   stride_ = (frame_.lx() + 7) / 8 * 8 + 8;
   frame_buf_.assign(static_cast<size_t>(ns_), std::vector<double>(frame_.size()));
@@ -174,7 +176,7 @@ void FusedSweep::sweep_tile(const std::vector<const double*>& in, const std::vec
   row.prow = prow.data();
   row.src = src.data();
   row.dst = dst.data();
-  row.wclass = nullptr;
+  row.wclass = by_class_ ? classes_.w.data() : nullptr;
   auto margin = [&](int l) { return W - static_cast<PetscInt>(n - l) * r_; };
   // Box columns [x0, x1) of row jl of step l; step 1 reads the input rows' `edge` or `mid` base.
   auto sweep_piece = [&](int l, PetscInt jl, PetscInt x0, PetscInt x1, bool mid) {
@@ -205,10 +207,21 @@ void FusedSweep::sweep_tile(const std::vector<const double*>& in, const std::vec
     sweep_piece(l, jl, b, x1, mid);
   };
   const PetscInt e0 = margin(0);
+  // Input row jw + kPrefetchRows of the tile's columns, a part per level (the owned rows are
+  // read from memory; the prefetches spread over the levels' arithmetic).
+  const PetscInt pc0 = std::max(t0 - n, W), pc1 = std::min(t1 + n, W + mx);
+  auto prefetch_part = [&](PetscInt jw, int l) {
+    const PetscInt jp = jw + kPrefetchRows;
+    if (!frame_.owned_row(jp)) return;
+    const PetscInt len = pc1 - pc0, c0 = pc0 + len * (l - 1) / n, c1 = pc0 + len * l / n;
+    for (int s = 0; s < ns_; ++s)
+      prefetch_doubles(in[s] + grid_.local_index(ob.s[0] + c0 - W, ob.s[1] - W + jp, 0), c1 - c0);
+  };
   for (PetscInt jw = e0; jw < ly - e0; ++jw) {
     for (int s = 0; s < ns_; ++s)
       in0_[s][jw % ring_] = input_row(in, s, jw, left);
     for (int l = 1; l <= n; ++l) {
+      prefetch_part(jw, l);
       const PetscInt jl = jw - static_cast<PetscInt>(l) * r_, e = margin(l);
       if (jl < e || jl >= ly - e) continue;
       for (int q = 0; q < nr; ++q) // ring slot of each stencil row (one modulo per row)

@@ -12,7 +12,10 @@
 // its row jw - l r, whose neighbours rows jw - l r +- r of step l - 1 are ready. Each step keeps a
 // ring of 2r + 1 rows per species (2r + 1 rows of Lx cells per step and species stay in cache); the
 // last step writes the owned row of the output arrays. Memory traffic per n steps: one read
-// and one write of the state, instead of n of each.
+// and one write of the state, instead of n of each; the owned input rows kPrefetchRows ahead
+// are prefetched, a part per level. The 9pt stencil runs in its weight-class form (rows in
+// class order, ExplicitRow::wclass), as the single steps do, so the ring rows, which share one
+// alignment, are read as whole aligned vectors.
 // In place (out == in): step n writes row j of a tile only after step 1 has read it for the last
 // time (n >= 2), so only the columns a tile reads left of its own, which the tiles before it have
 // overwritten, are saved: per tile after the first, its n columns left of it of every owned row,
@@ -79,6 +82,7 @@ private:
   const double* param_at(size_t q, const double* f, PetscInt jw, PetscInt x) const;
   LeftStrip save_left_strip(const std::vector<const double*>& in, int n, PetscInt t0,
                             size_t tile) const;
+  static constexpr PetscInt kPrefetchRows = 2; // input rows ahead of the wavefront prefetched
   static constexpr double kTileBytes = 1024.0 * 1024; // ring rows of one tile: half an L2
   PetscInt tile_width(int n) const;                   // owned columns per tile of a pass of n steps
   void sweep_tile(const std::vector<const double*>& in, const std::vector<double*>& out, int n,
@@ -86,7 +90,9 @@ private:
                   const std::vector<const double*>& pf) const;
 
   const Grid& grid_;
-  RowStencil rows_;
+  RowStencil rows_;       // in class order where by_class_
+  BoxClasses classes_;    // the box stencil's weights by class (9pt)
+  bool by_class_ = false; // the kernel's weight-class form (ExplicitRow::wclass)
   int ns_, depth_;
   PetscInt tile_;
   int r_;

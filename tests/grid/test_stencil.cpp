@@ -204,13 +204,49 @@ TEST(Stencil, BoxClassesOfTheIsotropicBoxStencils) {
     dup.off[8] = dup.off[7];
     EXPECT_FALSE(box_classes(dup, c));
   }
-  Stencil s7, s9;
-  RowStencil r7, r9;
+  Stencil s5, s7;
+  RowStencil r5, r7;
   BoxClasses c;
+  ASSERT_TRUE(make_stencil("5pt", 2, h, s5));
   ASSERT_TRUE(make_stencil("7pt", 3, h, s7));
-  ASSERT_TRUE(make_stencil("9pt", 2, h, s9));
+  ASSERT_TRUE(to_rows(s5, r5));
   ASSERT_TRUE(to_rows(s7, r7));
-  ASSERT_TRUE(to_rows(s9, r9));
+  EXPECT_FALSE(box_classes(r5, c)) << "star stencils have no class form";
   EXPECT_FALSE(box_classes(r7, c));
-  EXPECT_FALSE(box_classes(r9, c));
+}
+
+// 2-D 9pt: (4 (N+S+E+W) + diagonals - 20 u) / (6 h^2) as centre, face and edge (the diagonals)
+// classes, no corner class; the rows in class order; a changed tap or row refused.
+TEST(Stencil, BoxClassesOfThe2D9ptStencil) {
+  const double h[3] = {0.5, 0.5, 0.5};
+  const double s2 = 1.0 / (h[0] * h[0]);
+  Stencil s;
+  ASSERT_TRUE(make_stencil("9pt", 2, h, s));
+  RowStencil r;
+  ASSERT_TRUE(to_rows(s, r));
+  BoxClasses c;
+  ASSERT_TRUE(box_classes(r, c));
+  const double expect[4] = {-20.0 / 6, 4.0 / 6, 1.0 / 6, 0.0};
+  for (int k = 0; k < 4; ++k)
+    EXPECT_NEAR(c.w[k], expect[k] * s2, 1e-12 * s2) << "class " << k;
+  EXPECT_EQ(c.perm[0], 0);
+  EXPECT_EQ(std::abs(r.off[c.perm[1]][0]) + std::abs(r.off[c.perm[2]][0]), 2);
+  EXPECT_NE(c.perm[1], c.perm[2]);
+  for (int q = 0; q < 3; ++q)
+    for (int dx = -1; dx <= 1; ++dx)
+      EXPECT_EQ(r.w[3 * q + dx + 1], c.w[(r.off[q][0] != 0) + (dx != 0)]);
+  RowStencil ordered = r;
+  BoxClasses c2;
+  ASSERT_TRUE(to_class_order(ordered, c2));
+  for (int q = 0; q < 3; ++q) {
+    EXPECT_EQ(ordered.off[q], r.off[c.perm[q]]);
+    for (int t = 0; t < 3; ++t)
+      EXPECT_EQ(ordered.w[3 * q + t], r.w[3 * c.perm[q] + t]);
+  }
+  RowStencil bad = r; // a face tap changed (as for hx != hy)
+  bad.w[3 * c.perm[1] + 1] *= 1.5;
+  EXPECT_FALSE(box_classes(bad, c2));
+  RowStencil dup = r; // a row repeated
+  dup.off[2] = dup.off[1];
+  EXPECT_FALSE(box_classes(dup, c2));
 }
