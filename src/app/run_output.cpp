@@ -201,7 +201,11 @@ void RunOutput::begin(Simulation& sim, long long restart_step, PetscInt end_step
     next_checkpoint_time_ = next_multiple(sim.time(), out.checkpoint_every_time);
   last_step_wall_ = MPI_Wtime();
   sampler_ = FieldSampler();
+  // Up to 1000 samples per run; each sample ends a fused pass, so the cadence is a whole
+  // number of explicit passes (a run of fused passes keeps its steps per pass).
+  const PetscInt fuse = std::max<PetscInt>(1, sim.pass_depth());
   sample_every_ = std::max<PetscInt>(1, (end_step - sim.step_index()) / 1000);
+  sample_every_ = (sample_every_ + fuse - 1) / fuse * fuse;
   if (out.summary) sampler_.take(sim);
   const bool periodic = out.snapshot_every > 0 || out.snapshot_every_time > 0;
   if (restart_step < 0 && sim.level() == 0 && periodic) write_snapshot(sim);

@@ -95,6 +95,9 @@ public:
   void step();
   // Steps advance() may take in one pass (-explicit_fuse_steps where it applies, else 1).
   PetscInt fuse_steps() const { return fuse_; }
+  // The fixed depth of a fused pass (explicit -explicit_fuse_steps), 1 where passes have none
+  // (one step, or split passes that run until the next observation).
+  PetscInt pass_depth() const { return split_ ? 1 : fuse_; }
   // Advance n <= fuse_steps() steps, bitwise the same as n calls of step() (no output between).
   void advance(PetscInt n);
   // The run's terms and constraints (what the integrators consume).

@@ -1,11 +1,12 @@
 """End-to-end temporal blocking (-explicit_fuse_steps): a 2-rank run of input/turing_spots.yaml
 (per-cell Gaussian parameters, periodic, 5-point) with snapshots, checkpoints, PNGs and
-progress lines falling inside would-be passes (no summary: its samples every 1/1000 of a run
-would end every pass of so short a run), and a step count that is no multiple of k, writes the same
-bytes in every HDF5 dataset and PNG as the same run with k = 1; an unsupported configuration
+progress lines falling inside would-be passes, and a step count that is no multiple of k,
+writes the same bytes in every HDF5 dataset and PNG as the same run with k = 1; the summary's
+samples come a whole number of passes apart, so they do not shorten passes; an unsupported configuration
 (zero-flux boundaries) runs one step per pass with a log line saying why. Parameter fields of
 one value give the scalars' bits in every parameter form of the row kernels."""
 import glob
+import json
 import os
 import re
 
@@ -49,6 +50,23 @@ def test_fused_run_writes_the_same_files(tmp_path, k):
     for path in pngs:
         with open(path, "rb") as f1, open(path.replace(os.sep + "k1" + os.sep, os.sep + f"k{k}" + os.sep), "rb") as f2:
             assert f1.read() == f2.read(), path
+
+
+def test_summary_samples_keep_whole_passes(tmp_path):
+    """A short run samples its summary up to every step; with k = 4 every 4th step, so 203
+    steps take ceil(203 / 4) = 51 passes, and the final field's metrics are those of k = 1."""
+    quiet = ["-grid_n", "64,64", "-steps", "203", "-png_every", "0", "-progress_every", "1000",
+             "-nan_check_every", "1000"]
+    summaries = {}
+    for kk in (1, 4):
+        p = run([DECK] + quiet + ["-explicit_fuse_steps", str(kk), "-output_dir", f"k{kk}"],
+                tmp_path, ranks=2)
+        assert p.returncode == 0, p.stderr
+        with open(tmp_path / f"k{kk}" / "summary.json") as f:
+            summaries[kk] = json.load(f)
+    assert "fused steps: 203 steps in 51 passes (up to 4 steps each)" in p.stdout, p.stdout
+    for s in ("a", "b"):
+        assert summaries[1]["species"][s]["metrics"] == summaries[4]["species"][s]["metrics"]
 
 
 def test_unsupported_falls_back_with_a_log_line(tmp_path):
