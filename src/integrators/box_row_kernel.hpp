@@ -101,8 +101,23 @@ template <int L> struct BoxLanes {
       r[l] = std::fma(a[l], b[l], c[l]);
     return r;
   }
-  // Lanes k .. k + L - 1 of the concatenation (a, b).
+  // Lanes k .. k + L - 1 of the concatenation (a, b). With AVX-512 one valignq, which leaves
+  // both inputs in their registers (GCC's shuffle picks vpermt2pd, which overwrites one, and
+  // then copies registers around it). (The all-lanes masked form: GCC 12 warns about the
+  // undefined source operand of the unmasked one.)
   template <int K> static V shift(V a, V b) {
+#if defined(__AVX512F__)
+    if constexpr (L == 8) {
+      const __m512i ai = _mm512_castpd_si512(a), bi = _mm512_castpd_si512(b);
+      return _mm512_castsi512_pd(_mm512_mask_alignr_epi64(ai, 0xFF, bi, ai, K));
+    }
+#endif
+#if defined(__AVX512VL__)
+    if constexpr (L == 4) {
+      const __m256i ai = _mm256_castpd_si256(a), bi = _mm256_castpd_si256(b);
+      return _mm256_castsi256_pd(_mm256_mask_alignr_epi64(ai, 0xF, bi, ai, K));
+    }
+#endif
     if constexpr (L == 8)
       return __builtin_shuffle(a, b, I{K, K + 1, K + 2, K + 3, K + 4, K + 5, K + 6, K + 7});
     else

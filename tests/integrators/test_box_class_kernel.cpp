@@ -92,7 +92,7 @@ ExplicitRow gray_scott_row(const BoxRows& st, bool by_class, int len, const doub
 
 // Cells [i0, i0 + len) of the block's middle row through explicit_row<GS, NR, true, PR> (NR the
 // stencil's rows: 3 or 9): by class (rows in classes.perm order) or by the general row form.
-template <ParamRows PR>
+template <ParamRows PR, bool Wide = false>
 void run_row(const Block& b, const BoxRows& st, bool by_class, const double* p, int i0, int len,
              std::vector<double> (&out)[2]) {
   const double* src[18];
@@ -118,9 +118,9 @@ void run_row(const Block& b, const BoxRows& st, bool by_class, const double* p, 
   ExplicitRow a = gray_scott_row(st, by_class, len, src, dst, floor, p);
   a.prow = prow;
   if (nr == 3)
-    explicit_row<GS, 3, true, PR>(a);
+    explicit_row<GS, 3, true, PR, Wide>(a);
   else
-    explicit_row<GS, 9, true, PR>(a);
+    explicit_row<GS, 9, true, PR, Wide>(a);
 }
 
 double wave(int s, double x, double y, double z) {
@@ -181,22 +181,33 @@ TEST(BoxClassKernel, SameBitsWhateverPartOfTheRowACallCovers) {
                                                 {0, kBoxChunk, kN},
                                                 {0, 7, kBoxChunk + 9, kN - 3, kN},
                                                 {0, 2, 5, 11, 12, 30, 47, kN}};
-  for (const long pitch : {kN + 2L, kPadded})
-    for (const char* name : kStencils) {
-      const Block b(wave, pitch);
-      const BoxRows st(name, b.h);
-      std::vector<double> whole[2];
-      run_row<kScalarParams>(b, st, true, p, 0, kN, whole);
-      for (const auto& cut : splits) {
-        std::vector<double> pieces[2];
-        for (size_t c = 0; c + 1 < cut.size(); ++c)
-          run_row<kScalarParams>(b, st, true, p, cut[c], cut[c + 1] - cut[c], pieces);
-        for (int s = 0; s < 2; ++s)
-          for (int i = 0; i < kN; ++i)
-            ASSERT_EQ(whole[s][i], pieces[s][i]) << name << " s " << s << " i " << i << " pieces "
-                                                 << cut.size() - 1 << " pitch " << pitch;
+  // Both lane widths: the blocks of 4 or 8 cells (reaction in the lanes) against the chunks
+  // (and the cells before an aligned start) wherever a cut moves a cell from one to the other.
+  auto row = [&](bool wide, const Block& b, const BoxRows& st, int i0, int len,
+                 std::vector<double>(&out)[2]) {
+    if (wide)
+      run_row<kScalarParams, true>(b, st, true, p, i0, len, out);
+    else
+      run_row<kScalarParams, false>(b, st, true, p, i0, len, out);
+  };
+  for (const bool wide : {false, true})
+    for (const long pitch : {kN + 2L, kPadded})
+      for (const char* name : kStencils) {
+        const Block b(wave, pitch);
+        const BoxRows st(name, b.h);
+        std::vector<double> whole[2];
+        row(wide, b, st, 0, kN, whole);
+        for (const auto& cut : splits) {
+          std::vector<double> pieces[2];
+          for (size_t c = 0; c + 1 < cut.size(); ++c)
+            row(wide, b, st, cut[c], cut[c + 1] - cut[c], pieces);
+          for (int s = 0; s < 2; ++s)
+            for (int i = 0; i < kN; ++i)
+              ASSERT_EQ(whole[s][i], pieces[s][i])
+                  << name << " s " << s << " i " << i << " pieces " << cut.size() - 1 << " pitch "
+                  << pitch << " wide " << wide;
+        }
       }
-    }
 }
 
 // box_row_diffusion (lane shifts on GCC, blocks of 4 or 8 lanes with an overlapping last block)
