@@ -182,7 +182,7 @@ void print_fused_ring_bound(MPI_Comm comm, const std::string& stencil, double ro
   const double ns = time_fused_ring(comm, stencil, n, levels);
   const double cups = size / (ns * 1e-9);
   PetscPrintf(comm,
-              "explicit_fused_ring stencil=%s row=%d levels=%d ns_per_cell=%.3f "
+              "explicit_fused_ring stencil=%s row=%d levels=%d ns_per_cell=%.4f "
               "cell_updates_per_s=%.4e roofline_fraction=%.3f (a fused pass's levels with every "
               "row in the ring, the state neither read nor written: what its passes reach at "
               "most)\n",
