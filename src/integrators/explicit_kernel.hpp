@@ -132,7 +132,7 @@ inline void box_class_cell(int i, const double* d, int dstride,
 // shifts' loads stay within the rows (x + 2 L - 2 <= n): per block each species' d
 // (box_row_diffusion's lane-shift expressions) stays in registers and the reaction runs over
 // the block's lanes (one vector each: `unroll 1` keeps GCC from unrolling the 4-lane loop
-// before it vectorises it), with no buffer pass between them: 47 instead of about 60
+// before it vectorises it), with no buffer pass between them: 46 instead of about 60
 // instructions per 8 cells and species pair at 512 bits. Returns the number of cells done;
 // the same expressions per cell as the chunks, so the same bits.
 template <class M, int NR, ParamRows PR, bool Corners, bool Clamp, bool Wide, int NP>
