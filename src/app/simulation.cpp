@@ -678,8 +678,8 @@ void Simulation::read_fuse(Options& opt) {
   const std::string prefetch = opt.choice(
       "explicit_prefetch", "auto", {"auto", "yes", "no"},
       "explicit fast path, single steps: software prefetch of the row read from memory two rows "
-      "after the stencil's leading row (auto: where a rank's state is at least 8 MiB); the same "
-      "results");
+      "after the stencil's leading row (box stencils: by the row kernel between its cells; auto: "
+      "where a rank's state is at least 8 MiB); the same results");
   integrator_->set_prefetch(prefetch == "yes"  ? ExplicitIntegrator::Prefetch::Always
                             : prefetch == "no" ? ExplicitIntegrator::Prefetch::Never
                                                : ExplicitIntegrator::Prefetch::Auto);

@@ -428,9 +428,16 @@ void ExplicitIntegrator::sweep(std::vector<VecH>& u, std::vector<VecH>* work, do
             prow[q] = pf[q] ? pf[q] + o : const_rows_[q].data();
         }
         if (fill_x) wrap_x(in, c, row.rows, gx);
-        if (pf_off >= 0 && c + pf_off <= pf_end)
+        // The row read first kPrefetchRows rows later in the block's order (in 3-D, near the
+        // block's last row, a row of the next plane's block rows).
+        const PetscInt ahead =
+            pf_off < 0 || j + kPrefetchRows < jend ? pf_off : pf_off - bh * gx + gxy;
+        row.prefetch_ahead = ahead >= 0 && c + ahead <= pf_end ? ahead : 0;
+        if (!by_class_ && row.prefetch_ahead != 0) { // the tap loop: the whole row, before it
           for (int s = 0; s < ns_; ++s)
-            prefetch_doubles(in[s] + c + pf_off, ob.m[0]);
+            prefetch_doubles(in[s] + c + row.prefetch_ahead, ob.m[0]);
+          row.prefetch_ahead = 0;
+        }
         row_fn(row);
         if (in_place && t >= lag) commit_row(in, t - lag, jb, bh, to_edge);
       }

@@ -94,9 +94,13 @@ public:
   void set_in_place(InPlace mode) { in_place_ = mode; }
 
   // Software prefetch, in the single-step sweep, of the row read from memory kPrefetchRows rows
-  // after the stencil's leading row (core/prefetch.hpp): Auto where a rank's state is at least
-  // kPrefetchBytes (out of the per-core caches; in cache the prefetches only cost instructions);
-  // Always and Never force it. Nothing read changes, so neither do the results. (Fused passes
+  // after the stencil's leading row (in 3-D blocks, near a block's last row, the row of the next
+  // plane read first two rows later). Box stencils: issued by the row kernel one cache line at
+  // a time between its cells (ExplicitRow::prefetch_ahead; 4096^2 9pt 25-30 % faster than the
+  // whole row before the call, which stalls on the core's miss buffers); the 5/7-point tap loop
+  // gets the whole row before its call (faster there, README, Performance). Auto where a rank's
+  // state is at least kPrefetchBytes (out of the per-core caches; in cache the prefetches only
+  // cost instructions); Always and Never force it. Nothing read changes, so neither do the results. (Fused passes
   // do not prefetch: their rows take k times the arithmetic, which hides the loads already;
   // prefetching there measured 1-5 % slower at 4096^2, k = 8.)
   enum class Prefetch { Auto, Always, Never };

@@ -60,7 +60,32 @@ struct ExplicitRow {
   // kernels sweep one row; callers set rows = 1 for them).
   int rows = 1;
   long src_stride = 0, dst_stride = 0;
+  // Software prefetch (box stencils by class, single-row calls): when nonzero, the kernel
+  // prefetches each species' centre row prefetch_ahead cells past the cells it computes, one
+  // prefetch per cache line, spread over its arithmetic (kernel_prefetch: per block of 8 cells,
+  // per chunk). The tap loop ignores it (its callers prefetch the row before the call). Reads
+  // nothing, so changes no result.
+  long prefetch_ahead = 0;
 };
+
+// Cells per prefetch: one 64-byte cache line.
+constexpr int kCellsPerLine = 8;
+
+// One prefetch (into L1, for reading) of each species' centre row rows[s * step], `ahead`
+// cells past cell i. Prefetches never fault; no value read depends on them.
+template <int NS>
+inline void kernel_prefetch(const double* __restrict__ const* rows, int step, long i, long ahead) {
+  for (int s = 0; s < NS; ++s)
+    __builtin_prefetch(rows[s * step] + i + ahead, 0, 3);
+}
+
+// The same for cells i0 .. i0 + m - 1: one prefetch per line of each centre row.
+template <int NS>
+inline void kernel_prefetch_cells(const double* __restrict__ const* rows, int step, long i0, int m,
+                                  long ahead) {
+  for (int b = 0; b < m; b += kCellsPerLine)
+    kernel_prefetch<NS>(rows, step, i0 + b, ahead);
+}
 
 // The box stencils by weight class (ExplicitRow::wclass set), rows in class order: 3-D (19pt,
 // 27pt, NR = 9) src[s*9] the centre row, src[s*9 + 1..4] the face rows, src[s*9 + 5..8] the
@@ -140,7 +165,7 @@ inline int box_classes_blocks(const double* const* rows, const double (&wc)[M::n
                               const double* __restrict__ const* src,
                               double* __restrict__ const* dst,
                               const double* __restrict__ const* prow, const double* pc,
-                              const double* floor, double dt, int x0, int n) {
+                              const double* floor, double dt, int x0, int n, long ahead) {
   constexpr int NS = M::nspecies;
   constexpr int L = Wide ? 8 : 4;
   using B = BoxLanes<L>;
@@ -155,6 +180,8 @@ inline int box_classes_blocks(const double* const* rows, const double (&wc)[M::n
   int t = 0;
   for (; x0 + t + 2 * L - 2 <= n; t += L) {
     alignas(64) double dl[NS][L];
+    if (ahead != 0 && (L == kCellsPerLine || t % kCellsPerLine == 0))
+      kernel_prefetch<NS>(src, 1, x0 + t, ahead);
     for (int s = 0; s < NS; ++s) {
       V p1, q1;
       B::template profile<NR, Corners>(rows + s * NR, wv[s], x0 + t + L - 1, p1, q1);
@@ -195,6 +222,7 @@ inline void explicit_row_box_classes(const ExplicitRow& a) {
   const int n = a.n;
   alignas(64) double dbuf[NS][kBoxChunk];
   auto chunk = [&](int i0, int m) { // cells i0 .. i0 + m - 1, m <= kBoxChunk
+    if (a.prefetch_ahead != 0) kernel_prefetch_cells<NS>(src, 1, i0, m, a.prefetch_ahead);
     for (int s = 0; s < NS; ++s)
       box_row_diffusion<NR, Corners, Wide>(rows + s * NR, wc[s], i0, m, n, dbuf[s]);
 #pragma GCC ivdep
@@ -211,8 +239,8 @@ inline void explicit_row_box_classes(const ExplicitRow& a) {
     int b0 = a0;
 #if defined(__GNUC__) && !defined(__clang__) && !defined(__CUDACC__)
     if constexpr (NR == 3) // (the 9-row blocks measured slower at 512 bits: registers)
-      b0 += box_classes_blocks<M, NR, PR, Corners, Clamp, Wide, NP>(rows, wc, src, dst, prow, pc,
-                                                                    floor, dt, a0, n);
+      b0 += box_classes_blocks<M, NR, PR, Corners, Clamp, Wide, NP>(
+          rows, wc, src, dst, prow, pc, floor, dt, a0, n, a.prefetch_ahead);
 #endif
     for (int i0 = b0; i0 < n; i0 += kBoxChunk)
       chunk(i0, n - i0 < kBoxChunk ? n - i0 : kBoxChunk);

@@ -10,7 +10,9 @@
 // the table (256- and 512-bit vectors, -explicit_vector_width) are swept, every entry is set,
 // and the wide compile gives the narrow one's bits on every sub-row. Each form also gives the
 // bits of the all-rows kernel fed its scalars as rows of one value (a scalar kept in a register
-// is the same number as a row of it).
+// is the same number as a row of it). Software prefetch (ExplicitRow::prefetch_ahead, issued
+// between the box-class kernel's blocks and chunks) changes no bit either: sub-rows of even
+// length prefetch.
 #include "../model_typed_tests.hpp"
 #include <gtest/gtest.h>
 
@@ -31,7 +33,8 @@ using namespace morphogen;
 
 MG_MODEL_TYPED_TEST_SUITE(ExplicitRowPosition);
 
-constexpr int kN = 83; // cells in the row (a prime: no vector width divides it)
+constexpr int kN = 83;     // cells in the row (a prime: no vector width divides it)
+constexpr int kAhead = 24; // cells ahead that a prefetching call prefetches (the rows hold them)
 
 // Rows of one layout for species s: NR rows of kN + 2 values (x = -1 .. kN), around the
 // species' initial value, every cell different.
@@ -42,7 +45,7 @@ struct Rows {
   Rows(int ns, int nr_, int np, const double* init, const double* pdef) : nr(nr_) {
     for (int s = 0; s < ns; ++s)
       for (int r = 0; r < nr; ++r) {
-        std::vector<double> v(kN + 2);
+        std::vector<double> v(kN + 2 + kAhead);
         for (int i = 0; i < kN + 2; ++i)
           v[i] = init[s] * (1.0 + 0.3 * std::sin(0.77 * i + 1.3 * r + 0.4 * s)) + 0.01 * r;
         data.push_back(v);
@@ -59,7 +62,8 @@ struct Rows {
 // Sweeps cells [i0, i0 + n) of the rows into out (kN values per species).
 template <class M>
 void sweep(ExplicitRowFn fn, const Rows& rows, const double* w, const double* wclass,
-           const double* pdef, bool field, int i0, int n, std::vector<std::vector<double>>& out) {
+           const double* pdef, bool field, int i0, int n, std::vector<std::vector<double>>& out,
+           long ahead = 0) {
   constexpr int NS = M::nspecies;
   std::vector<const double*> src, prow;
   std::vector<double*> dst;
@@ -85,6 +89,7 @@ void sweep(ExplicitRowFn fn, const Rows& rows, const double* w, const double* wc
   a.pconst = pdef;
   a.dt = 0.05;
   a.dst = dst.data();
+  a.prefetch_ahead = ahead;
   fn(a);
 }
 
@@ -146,7 +151,7 @@ TYPED_TEST(ExplicitRowPosition, EveryCellTheSameBitsWhereverItLiesInTheRow) {
         for (int i0 = 0; i0 < 17; ++i0)
           for (int n = 1; i0 + n <= kN; n += (fn == wide ? 1 : 3)) {
             std::vector<std::vector<double>> part(NS, std::vector<double>(kN));
-            sweep<M>(fn, rows, w.data(), wc, pdef, field, i0, n, part);
+            sweep<M>(fn, rows, w.data(), wc, pdef, field, i0, n, part, n % 2 == 0 ? kAhead : 0);
             for (int s = 0; s < NS; ++s)
               for (int i = i0; i < i0 + n; ++i)
                 (fn == wide ? differ_wide : differ) +=
