@@ -160,7 +160,7 @@ inline void box_class_cell(int i, const double* d, int dstride,
 // before it vectorises it), with no buffer pass between them: 46 instead of about 60
 // instructions per 8 cells and species pair at 512 bits. Returns the number of cells done;
 // the same expressions per cell as the chunks, so the same bits.
-template <class M, int NR, ParamRows PR, bool Corners, bool Clamp, bool Wide, int NP>
+template <class M, int NR, ParamRows PR, bool Corners, bool Clamp, bool Wide, int NP, bool Prefetch>
 inline int box_classes_blocks(const double* const* rows, const double (&wc)[M::nspecies][4],
                               const double* __restrict__ const* src,
                               double* __restrict__ const* dst,
@@ -180,7 +180,7 @@ inline int box_classes_blocks(const double* const* rows, const double (&wc)[M::n
   int t = 0;
   for (; x0 + t + 2 * L - 2 <= n; t += L) {
     alignas(64) double dl[NS][L];
-    if (ahead != 0 && (L == kCellsPerLine || t % kCellsPerLine == 0))
+    if (Prefetch && (L == kCellsPerLine || t % kCellsPerLine == 0))
       kernel_prefetch<NS>(src, 1, x0 + t, ahead);
     for (int s = 0; s < NS; ++s) {
       V p1, q1;
@@ -238,9 +238,13 @@ inline void explicit_row_box_classes(const ExplicitRow& a) {
     if (a0 > 0) chunk(0, a0);
     int b0 = a0;
 #if defined(__GNUC__) && !defined(__clang__) && !defined(__CUDACC__)
-    if constexpr (NR == 3) // (the 9-row blocks measured slower at 512 bits: registers)
-      b0 += box_classes_blocks<M, NR, PR, Corners, Clamp, Wide, NP>(
-          rows, wc, src, dst, prow, pc, floor, dt, a0, n, a.prefetch_ahead);
+    if constexpr (NR == 3) { // (the 9-row blocks measured slower at 512 bits: registers)
+      const long ahead = a.prefetch_ahead; // a separate loop: no test per block without it
+      b0 += ahead != 0 ? box_classes_blocks<M, NR, PR, Corners, Clamp, Wide, NP, true>(
+                             rows, wc, src, dst, prow, pc, floor, dt, a0, n, ahead)
+                       : box_classes_blocks<M, NR, PR, Corners, Clamp, Wide, NP, false>(
+                             rows, wc, src, dst, prow, pc, floor, dt, a0, n, 0);
+    }
 #endif
     for (int i0 = b0; i0 < n; i0 += kBoxChunk)
       chunk(i0, n - i0 < kBoxChunk ? n - i0 : kBoxChunk);
