@@ -100,9 +100,9 @@ public:
   // whole row before the call, which stalls on the core's miss buffers); the 5/7-point tap loop
   // gets the whole row before its call (faster there, README, Performance). Auto where a rank's
   // state is at least kPrefetchBytes (out of the per-core caches; in cache the prefetches only
-  // cost instructions); Always and Never force it. Nothing read changes, so neither do the results. (Fused passes
-  // do not prefetch: their rows take k times the arithmetic, which hides the loads already;
-  // prefetching there measured 1-5 % slower at 4096^2, k = 8.)
+  // cost instructions); Always and Never force it. Nothing read changes, so neither do the results.
+  // (Fused passes do not prefetch: their rows take k times the arithmetic, which hides the loads
+  // already; prefetching there measured 1-5 % slower at 4096^2, k = 8.)
   enum class Prefetch { Auto, Always, Never };
   static constexpr double kPrefetchBytes = kPrefetchMinBytes;
   static constexpr int kPrefetchRows = kPrefetchRowsAhead;
