@@ -34,6 +34,7 @@
 // it).
 #pragma once
 
+#include "core/prefetch.hpp"
 #include "fields/clamp_kernel.hpp"
 #include "integrators/box_row_kernel.hpp"
 
@@ -71,20 +72,14 @@ struct ExplicitRow {
 // Cells per prefetch: one 64-byte cache line.
 constexpr int kCellsPerLine = 8;
 
-// One prefetch (into L1, for reading) of each species' centre row rows[s * step], `ahead`
-// cells past cell i. Prefetches never fault; no value read depends on them.
+// One prefetch (into L1, for reading) of each species' centre row rows[s], `ahead` cells past
+// cell i, for cells i .. i + m - 1 (core/prefetch.hpp: one per cache line). Prefetches never
+// fault; no value read depends on them.
 template <int NS>
-inline void kernel_prefetch(const double* __restrict__ const* rows, int step, long i, long ahead) {
+inline void kernel_prefetch(const double* __restrict__ const* rows, long i, long ahead,
+                            int m = kCellsPerLine) {
   for (int s = 0; s < NS; ++s)
-    __builtin_prefetch(rows[s * step] + i + ahead, 0, 3);
-}
-
-// The same for cells i0 .. i0 + m - 1: one prefetch per line of each centre row.
-template <int NS>
-inline void kernel_prefetch_cells(const double* __restrict__ const* rows, int step, long i0, int m,
-                                  long ahead) {
-  for (int b = 0; b < m; b += kCellsPerLine)
-    kernel_prefetch<NS>(rows, step, i0 + b, ahead);
+    prefetch_doubles(rows[s] + i + ahead, m);
 }
 
 // The box stencils by weight class (ExplicitRow::wclass set), rows in class order: 3-D (19pt,
@@ -181,7 +176,7 @@ inline int box_classes_blocks(const double* const* rows, const double (&wc)[M::n
   for (; x0 + t + 2 * L - 2 <= n; t += L) {
     alignas(64) double dl[NS][L];
     if (Prefetch && (L == kCellsPerLine || t % kCellsPerLine == 0))
-      kernel_prefetch<NS>(src, 1, x0 + t, ahead);
+      kernel_prefetch<NS>(src, x0 + t, ahead);
     for (int s = 0; s < NS; ++s) {
       V p1, q1;
       B::template profile<NR, Corners>(rows + s * NR, wv[s], x0 + t + L - 1, p1, q1);
@@ -222,7 +217,7 @@ inline void explicit_row_box_classes(const ExplicitRow& a) {
   const int n = a.n;
   alignas(64) double dbuf[NS][kBoxChunk];
   auto chunk = [&](int i0, int m) { // cells i0 .. i0 + m - 1, m <= kBoxChunk
-    if (a.prefetch_ahead != 0) kernel_prefetch_cells<NS>(src, 1, i0, m, a.prefetch_ahead);
+    if (a.prefetch_ahead != 0) kernel_prefetch<NS>(src, i0, a.prefetch_ahead, m);
     for (int s = 0; s < NS; ++s)
       box_row_diffusion<NR, Corners, Wide>(rows + s * NR, wc[s], i0, m, n, dbuf[s]);
 #pragma GCC ivdep

@@ -83,9 +83,9 @@ def test_bad_use_is_one_line(tmp_path, args, message):
 # -explicit_prefetch (integrators/explicit_integrator.hpp, core/prefetch.hpp): software prefetch
 # of the rows a single-step sweep reads from memory (box stencils: issued by the row kernel
 # between its blocks of cells; 5/7-point: the whole row before the kernel); forced on at these
-# small grids (auto turns it on from 8 MiB of state per rank), it
-# must not change a bit. gray_scott_scalar_clamp also takes the per-row calls that replace the
-# multi-row ones when prefetching.
+# small grids (auto turns it on from 8 MiB of state per rank), it must not change a bit.
+# gray_scott_scalar_clamp also takes the per-row calls that replace the multi-row ones when
+# prefetching.
 PREFETCH_CASES = ["periodic_5pt", "neumann_9pt_in_place", "gray_scott_scalar_clamp",
                   "periodic_3d_7pt", "neumann_3d_19pt", "dirichlet_3d_27pt_in_place"]
 
