@@ -19,6 +19,7 @@
 //   roofline_fraction=<2-D fraction>
 #include "app/pattern_summary.hpp"
 #include "app/simulation.hpp"
+#include "bench/bench_access_pattern.hpp"
 #include "bench/bench_fluids.hpp"
 #include "bench/bench_fused.hpp"
 #include "bench/bench_kernel_rate.hpp"
@@ -509,6 +510,12 @@ int run(MPI_Comm comm) {
   const bool only_fluids = opt.flag("bench_only_fluids", false, "only the fluids section");
   const bool only_fused =
       opt.flag("bench_only_fused", false, "only the fused-steps (temporal blocking) section");
+  const PetscInt access_rows = opt.integer(
+      "bench_access_rows", 2048, 0, 1 << 20,
+      "rows of 4096 cells per rank and species of the access-pattern section (the memory side of "
+      "an explicit step without its arithmetic; 2048: 64 MiB per species and rank; 0: skip)");
+  const bool only_access =
+      opt.flag("bench_only_access_pattern", false, "only the access-pattern section");
   const FusedSettings fused = read_fused_settings(opt);
   const ScalingNetwork net = read_scaling_network(opt);
   if (opt.help_requested()) {
@@ -520,7 +527,7 @@ int run(MPI_Comm comm) {
   if (with_fluids || only_fluids)
     bench_fluids(comm, opt, static_cast<int>(fluids_n), static_cast<int>(fluids_steps));
   if (only_fluids) return 0;
-  if (output_n > 0) bench_output(comm, opt, static_cast<int>(output_n));
+  if (output_n > 0 && !only_access) bench_output(comm, opt, static_cast<int>(output_n));
   const double bw = stream_triad(comm, static_cast<size_t>(mb) * 1024 * 1024 / 8, 10);
   const double roof = bw / 32.0;
   PetscPrintf(comm, "ranks=%d\nstream_triad_GBps=%.2f\nroofline_cell_updates_per_s=%.4e\n", size,
@@ -533,6 +540,9 @@ int run(MPI_Comm comm) {
     PetscPrintf(comm, "halo_%s halo_only_update_ms=%.4f dm_global_to_local_ms=%.4f\n", tag,
                 1e3 * r.halo_s, 1e3 * r.g2l_s);
   };
+  if (access_rows > 0 && !only_implicit)
+    bench_access_pattern(comm, static_cast<int>(access_rows), roof);
+  if (only_access) return 0;
   if (!only_implicit) bench_fused(comm, opt, fused, roof);
   if (only_fused) return 0;
   if (with_implicit) {

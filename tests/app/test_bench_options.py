@@ -8,7 +8,7 @@ import pytest
 from conftest import EXE, SOURCE, error_lines, run
 
 BENCH = os.path.join(os.path.dirname(EXE), "morphogen-bench")
-TIMING_LINE = re.compile(r"^(stream_triad|explicit_|output_|split_|scaling_)", re.M)
+TIMING_LINE = re.compile(r"^(stream_triad|explicit_|output_|split_|scaling_|access_)", re.M)
 
 
 def bench(args, cwd, ranks=1, timeout=120):
@@ -48,6 +48,7 @@ CASES = [
     ("fuse_n_not_int", ["-bench_fuse_n", "2048,big"], ["-bench_fuse_n big", "not an integer"]),
     ("net_range", ["-bench_net_GBps", "0"], ["-bench_net_GBps", "allowed [1e-06, 1000000]"]),
     ("side_3d", ["-bench_3d_n", "4"], ["-bench_3d_n", "allowed [8, 1024]"]),
+    ("access_rows", ["-bench_access_rows", "-1"], ["-bench_access_rows", "allowed [0, 1048576]"]),
 ]
 
 
