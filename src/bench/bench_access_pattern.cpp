@@ -1,6 +1,7 @@
 #include "bench/bench_access_pattern.hpp"
 
 #include "core/prefetch.hpp"
+#include "core/stream_copy.hpp"
 
 #include <petscsys.h>
 
@@ -50,7 +51,16 @@ struct State {
 
 // Interior rows 1 .. rows - 2 in place. Lag 0: the new row goes back at once (taps of its own row
 // only); lag 1: row j - 1 goes back after row j is computed (5-point taps read it).
-template <Taps T, bool Prefetch> void ring_sweep(State& s, long rows, std::vector<double>& ring) {
+// The ring's row back into the state: memcpy, or streaming stores (core/stream_copy.hpp).
+template <bool Stream> void commit(double* dst, const double* src) {
+  if constexpr (Stream)
+    stream_copy(dst, src, kRow);
+  else
+    std::memcpy(dst, src, kRow * sizeof(double));
+}
+
+template <Taps T, bool Prefetch, bool Stream = false>
+void ring_sweep(State& s, long rows, std::vector<double>& ring) {
   constexpr long lag = T == Taps::FivePoint ? 1 : 0;
   for (long j = 1; j < rows - 1; ++j) {
     double *ra = s.row(s.a, j), *rb = s.row(s.b, j);
@@ -62,15 +72,16 @@ template <Taps T, bool Prefetch> void ring_sweep(State& s, long rows, std::vecto
     row_update<T>(ra, rb, d, d + kRow);
     if (j - lag >= 1) {
       const double* p = ring.data() + ((j - lag) & 1) * 2 * kRow;
-      std::memcpy(s.row(s.a, j - lag), p, kRow * sizeof(double));
-      std::memcpy(s.row(s.b, j - lag), p + kRow, kRow * sizeof(double));
+      commit<Stream>(s.row(s.a, j - lag), p);
+      commit<Stream>(s.row(s.b, j - lag), p + kRow);
     }
   }
   if (lag == 1) {
     const double* p = ring.data() + ((rows - 2) & 1) * 2 * kRow;
-    std::memcpy(s.row(s.a, rows - 2), p, kRow * sizeof(double));
-    std::memcpy(s.row(s.b, rows - 2), p + kRow, kRow * sizeof(double));
+    commit<Stream>(s.row(s.a, rows - 2), p);
+    commit<Stream>(s.row(s.b, rows - 2), p + kRow);
   }
+  if (Stream) stream_fence();
 }
 
 void in_place_pointwise(State& s, long rows) {
@@ -102,31 +113,20 @@ void out_of_place(State& s, State& o, long rows) {
     row_update<Taps::FivePoint>(s.row(s.a, j), s.row(s.b, j), o.row(o.a, j), o.row(o.b, j));
 }
 
-// Seconds of the slowest rank, best of `reps` (a barrier before each).
-template <class F> double best_seconds(MPI_Comm comm, F&& f, int reps) {
-  double best = 1e30;
-  for (int r = 0; r < reps; ++r) {
-    MPI_Barrier(comm);
-    const double t0 = MPI_Wtime();
-    f();
-    double dt = MPI_Wtime() - t0, dtmax = 0;
-    MPI_Allreduce(&dt, &dtmax, 1, MPI_DOUBLE, MPI_MAX, comm);
-    best = std::min(best, dtmax);
-  }
-  return best;
-}
-
-// One 5-point sweep in place through the ring against the same sweep out of place: identical
-// interior values (the same expression per cell), on every rank.
+// One 5-point sweep in place through the ring (committed by memcpy and by streaming stores)
+// against the same sweep out of place: identical interior values (the same expression per
+// cell), on every rank.
 bool ring_matches_out_of_place(MPI_Comm comm, long rows) {
-  State s(rows, 1.0, 2.0), o(rows, 1.0, 2.0), ref(rows, 1.0, 2.0);
+  State s(rows, 1.0, 2.0), t(rows, 1.0, 2.0), o(rows, 1.0, 2.0), ref(rows, 1.0, 2.0);
   std::vector<double> ring(4 * kRow);
   ring_sweep<Taps::FivePoint, true>(s, rows, ring);
+  ring_sweep<Taps::FivePoint, false, true>(t, rows, ring);
   out_of_place(ref, o, rows);
   int same = 1;
   for (long j = 1; j < rows - 1; ++j)
-    same &= std::memcmp(s.row(s.a, j), o.row(o.a, j), kRow * sizeof(double)) == 0 &&
-            std::memcmp(s.row(s.b, j), o.row(o.b, j), kRow * sizeof(double)) == 0;
+    for (State* x : {&s, &t})
+      same &= std::memcmp(x->row(x->a, j), o.row(o.a, j), kRow * sizeof(double)) == 0 &&
+              std::memcmp(x->row(x->b, j), o.row(o.b, j), kRow * sizeof(double)) == 0;
   int all = 0;
   MPI_Allreduce(&same, &all, 1, MPI_INT, MPI_MIN, comm);
   return all == 1;
@@ -148,22 +148,20 @@ void bench_access_pattern(MPI_Comm comm, int rows_in, double roof) {
                 "cell_updates_per_s=%.4e fraction=%.3f\n",
                 name, rows, kRow, 1e9 * sec / cells, cups, cups / roof);
   };
-  const int reps = 5;
-  report("in_place_pointwise", best_seconds(
-                                   comm, [&] { in_place_pointwise(s, rows); }, reps));
-  report("in_place_save_old", best_seconds(
-                                  comm, [&] { in_place_save_old(s, rows, ring); }, reps));
-  report("ring_pointwise", best_seconds(
-                               comm, [&] { ring_sweep<Taps::Point, false>(s, rows, ring); }, reps));
-  report("ring_xtaps", best_seconds(
-                           comm, [&] { ring_sweep<Taps::X, false>(s, rows, ring); }, reps));
-  report("ring_5pt", best_seconds(
-                         comm, [&] { ring_sweep<Taps::FivePoint, false>(s, rows, ring); }, reps));
-  report("ring_5pt_prefetch",
-         best_seconds(
-             comm, [&] { ring_sweep<Taps::FivePoint, true>(s, rows, ring); }, reps));
-  report("out_of_place_5pt", best_seconds(
-                                 comm, [&] { out_of_place(s, o, rows); }, reps));
+  auto time = [&](auto&& f) { return slowest_best_seconds(comm, f, 5); };
+  report("in_place_pointwise", time([&] { in_place_pointwise(s, rows); }));
+  report("in_place_save_old", time([&] { in_place_save_old(s, rows, ring); }));
+  report("ring_pointwise", time([&] { ring_sweep<Taps::Point, false>(s, rows, ring); }));
+  report("ring_pointwise_stream",
+         time([&] { ring_sweep<Taps::Point, false, true>(s, rows, ring); }));
+  report("ring_xtaps", time([&] { ring_sweep<Taps::X, false>(s, rows, ring); }));
+  report("ring_5pt", time([&] { ring_sweep<Taps::FivePoint, false>(s, rows, ring); }));
+  report("ring_5pt_prefetch", time([&] { ring_sweep<Taps::FivePoint, true>(s, rows, ring); }));
+  report("ring_5pt_stream", time([&] { ring_sweep<Taps::FivePoint, false, true>(s, rows, ring); }));
+  report("ring_5pt_prefetch_stream",
+         time([&] { ring_sweep<Taps::FivePoint, true, true>(s, rows, ring); }));
+  report("out_of_place_5pt", time([&] { out_of_place(s, o, rows); }));
+  PetscPrintf(comm, "access_pattern streaming_stores=%s\n", stream_copy_kind());
   PetscPrintf(comm, "access_pattern check ring_5pt_equals_out_of_place=%s\n",
               ring_matches_out_of_place(comm, std::min<long>(rows, 64)) ? "yes" : "NO");
 }

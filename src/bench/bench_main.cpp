@@ -514,6 +514,10 @@ int run(MPI_Comm comm) {
       "bench_access_rows", 2048, 0, 1 << 20,
       "rows of 4096 cells per rank and species of the access-pattern section (the memory side of "
       "an explicit step without its arithmetic; 2048: 64 MiB per species and rank; 0: skip)");
+  const PetscInt access_3d_n = opt.integer(
+      "bench_access_3d_n", 256, 0, 1024,
+      "grid side of the access-pattern section's 3-D 7-point patterns (side^3 cells over the "
+      "ranks; 0: skip)");
   const bool only_access =
       opt.flag("bench_only_access_pattern", false, "only the access-pattern section");
   const FusedSettings fused = read_fused_settings(opt);
@@ -542,6 +546,8 @@ int run(MPI_Comm comm) {
   };
   if (access_rows > 0 && !only_implicit)
     bench_access_pattern(comm, static_cast<int>(access_rows), roof);
+  if (access_3d_n > 0 && !only_implicit)
+    bench_access_pattern_3d(comm, static_cast<int>(access_3d_n), roof);
   if (only_access) return 0;
   if (!only_implicit) bench_fused(comm, opt, fused, roof);
   if (only_fused) return 0;

@@ -49,6 +49,7 @@ CASES = [
     ("net_range", ["-bench_net_GBps", "0"], ["-bench_net_GBps", "allowed [1e-06, 1000000]"]),
     ("side_3d", ["-bench_3d_n", "4"], ["-bench_3d_n", "allowed [8, 1024]"]),
     ("access_rows", ["-bench_access_rows", "-1"], ["-bench_access_rows", "allowed [0, 1048576]"]),
+    ("access_3d", ["-bench_access_3d_n", "2000"], ["-bench_access_3d_n", "allowed [0, 1024]"]),
 ]
 
 
