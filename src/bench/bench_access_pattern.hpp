@@ -43,7 +43,8 @@ void bench_access_pattern(MPI_Comm comm, int rows, double roof);
 
 // The 3-D patterns (bench_access_pattern_3d.cpp), side^3 cells over the ranks (side x side x
 // side / P per rank): the 7-point in-place sweep in blocks of y rows through a ring (as the
-// explicit fast path), with and without its prefetch, without the blocks, and out of place.
+// explicit fast path), with and without its prefetch, without the blocks, and out of place; and
+// the in-place sweep reading the 9 rows of the 19/27-point stencils (3d_ring_9row_*).
 void bench_access_pattern_3d(MPI_Comm comm, int side, double roof);
 
 } // namespace morphogen

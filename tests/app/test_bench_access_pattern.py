@@ -12,7 +12,7 @@ NAMES = ["in_place_pointwise", "in_place_save_old", "ring_pointwise", "ring_poin
          "ring_xtaps", "ring_5pt", "ring_5pt_prefetch", "ring_5pt_stream",
          "ring_5pt_prefetch_stream", "out_of_place_5pt"]
 NAMES_3D = ["3d_ring_7pt_blocked", "3d_ring_7pt_blocked_prefetch", "3d_ring_7pt_unblocked",
-            "3d_out_of_place_7pt"]
+            "3d_out_of_place_7pt", "3d_ring_9row_blocked_prefetch"]
 LINE = re.compile(r"^access_pattern name=(\w+) "
                   r"(?:rows_per_rank=(\d+)x4096|cells_per_rank=(\d+)x(\d+)x(\d+)) "
                   r"ns_per_cell_per_rank=([\d.]+) cell_updates_per_s=([\d.e+-]+) "
@@ -40,7 +40,7 @@ def test_access_pattern_section(tmp_path, ranks):
         assert cups == pytest.approx(ranks / (ns * 1e-9), rel=2e-3 + 1e-3 / ns), name
         assert frac == pytest.approx(cups / roof, rel=2e-3, abs=1e-3), name
     assert "access_pattern check ring_5pt_equals_out_of_place=yes" in p.stdout
-    assert "access_pattern check 3d_ring_7pt_blocked_equals_out_of_place=yes" in p.stdout
+    assert "access_pattern check 3d_ring_blocked_equals_out_of_place=yes" in p.stdout
     # x86-64 always has streaming stores (SSE2 at least): the *_stream lines measure them
     assert re.search(r"^access_pattern streaming_stores=(512|256|128)-bit$", p.stdout, re.M)
     assert not re.search(r"^(explicit_|output_|split_|scaling_)", p.stdout, re.M), p.stdout
