@@ -1,7 +1,7 @@
 #include "bench/bench_access_pattern.hpp"
 
+#include "bench/bench_stream_copy.hpp"
 #include "core/prefetch.hpp"
-#include "core/stream_copy.hpp"
 
 #include <petscsys.h>
 
@@ -51,7 +51,7 @@ struct State {
 
 // Interior rows 1 .. rows - 2 in place. Lag 0: the new row goes back at once (taps of its own row
 // only); lag 1: row j - 1 goes back after row j is computed (5-point taps read it).
-// The ring's row back into the state: memcpy, or streaming stores (core/stream_copy.hpp).
+// The ring's row back into the state: memcpy, or streaming stores (bench_stream_copy.hpp).
 template <bool Stream> void commit(double* dst, const double* src) {
   if constexpr (Stream)
     stream_copy(dst, src, kRow);

@@ -13,7 +13,7 @@
 //   ring_5pt_prefetch    the same with the fast path's prefetch (the row two past the leading
 //                        row, before each row)
 //   ring_5pt_stream, ring_5pt_prefetch_stream  ring_5pt and ring_5pt_prefetch with the ring's
-//                        rows copied back by streaming stores (core/stream_copy.hpp)
+//                        rows copied back by streaming stores (bench_stream_copy.hpp)
 //   out_of_place_5pt     5-point taps into a second state set
 // printed as ns per cell and rank, aggregate cell-updates/s and the fraction of the roofline
 // `roof` (STREAM triad / 32 B), with a check that the ring sweeps give the out-of-place values.

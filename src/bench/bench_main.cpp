@@ -516,8 +516,8 @@ int run(MPI_Comm comm) {
       "an explicit step without its arithmetic; 2048: 64 MiB per species and rank; 0: skip)");
   const PetscInt access_3d_n = opt.integer(
       "bench_access_3d_n", 256, 0, 1024,
-      "grid side of the access-pattern section's 3-D 7-point patterns (side^3 cells over the "
-      "ranks; 0: skip)");
+      "grid side of the access-pattern section's 3-D patterns, the 7-point sweep and the 9 rows "
+      "of the 19/27-point stencils (side^3 cells over the ranks; 0: skip)");
   const bool only_access =
       opt.flag("bench_only_access_pattern", false, "only the access-pattern section");
   const FusedSettings fused = read_fused_settings(opt);

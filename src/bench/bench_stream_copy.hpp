@@ -1,3 +1,5 @@
+// For the access-pattern section (bench_access_pattern.cpp; measured slower than memcpy for the
+// solver's ring commit, so the solver does not use it):
 // dst[0 .. n) = src[0 .. n) with non-temporal (streaming) stores where the CPU has them (x86-64:
 // 512-, 256- or 128-bit): the destination's cache lines go to memory without being read first
 // or kept in the caches. The cells before dst's first 64-byte boundary (and after its last)
