@@ -35,7 +35,8 @@ MG_LANES_WIDE inline void explicit_lanes(LockstepLanes<M::nspecies, NP, W>& L, d
 #pragma GCC ivdep
   for (int l = 0; l < W; ++l) {
     double uc[NS], pc[NP], ru[NS], a[NS], b[NS], v[NS];
-    lane_inputs(L.u, L.p, l, uc, pc);
+    lane_state(L.u, l, uc);
+    lane_params<true>(L.p, nullptr, l, pc);
 #pragma GCC unroll 16
     for (int s = 0; s < NS; ++s) {
       a[s] = L.s0[s][l];

@@ -50,22 +50,36 @@ inline void store_clamped(const double (&v)[NS][W], int i0, const double* floor,
 }
 
 // The W lanes of one chunk (structure of arrays): inputs, iterate and per-lane state (0/1
-// flags as doubles so that every select vectorises).
+// flags as doubles so that every select vectorises: done, converged; act, still iterating, i.e.
+// neither converged nor left to the per-cell solver).
 template <int NS, int NP, int W> struct LockstepLanes {
   double u[NS][W], s0[NS][W], s1[NS][W], p[NP][W];
-  double base[NS][W], v[NS][W], F[NS][W], unorm[W], res[W], its[W], done[W], bad[W];
+  double base[NS][W], v[NS][W], F[NS][W], unorm[W], res[W], its[W], done[W], act[W];
 };
 
-// Lane l of the per-lane arrays x (a state: u or v) and p, as per-cell arrays.
-template <int NS, int NP, int W>
-inline void lane_inputs(const double (&x)[NS][W], const double (&p)[NP][W], int l, double* xc,
-                        double* pc) {
-#pragma GCC unroll 16
-  for (int q = 0; q < NP; ++q)
-    pc[q] = p[q][l];
+// Lane l of a per-lane state x (u or v) as a per-cell array.
+template <int NS, int W> inline void lane_state(const double (&x)[NS][W], int l, double* xc) {
 #pragma GCC unroll 16
   for (int s = 0; s < NS; ++s)
     xc[s] = x[s][l];
+}
+
+// Lane l's parameters: its row of the per-lane array where they vary (FieldParams), else the
+// constants themselves (no per-lane loads).
+template <bool FieldParams, int NP, int W>
+inline void lane_params(const double (&p)[NP][W], const double* pconst, int l, double* pc) {
+#pragma GCC unroll 16
+  for (int q = 0; q < NP; ++q)
+    pc[q] = FieldParams ? p[q][l] : pconst[q];
+}
+
+// r + s where the row has sources (Src), else r: adding a source-free row's zeros would change
+// nothing but the sign of a zero.
+template <bool Src> inline double plus_source(double r, double s) {
+  if constexpr (Src)
+    return r + s;
+  else
+    return r;
 }
 
 // Loads cells [i0, i0 + w) of the row into the lanes; lanes past the row repeat its last cell.

@@ -25,6 +25,8 @@
 // reaction_cell_of from its inputs, so damping and every failure report are exactly the
 // per-cell solver's. Results agree with the per-cell solver to rounding (Cramer vs. pivoted
 // LU: a few ulps of the update, far below tol; tests/integrators/test_reaction_lockstep.cpp).
+// A row without sources runs an instantiation that adds no zero sources, and scalar parameters
+// are read as the scalars themselves, not per lane: the same arithmetic, so the same values.
 //
 // reaction_row_lockstep has reaction_row's contract (reaction_kernel.hpp: clamped outputs,
 // -1 or the first failed cell, *worst, out may alias u); the explicit schemes go to the
@@ -56,6 +58,18 @@ template <int N> inline void cramer_numerators(const double* A, const double* b,
   }
 }
 
+// max_k |x[k]| (branch-free; from |x[0]| on, so a NaN may show: every caller's lane with a NaN
+// there is one that fails its finiteness test anyway).
+template <int N> inline double lane_max_abs(const double* x) {
+  double m = 0.0;
+#pragma GCC unroll 16
+  for (int k = 0; k < N; ++k) {
+    const double a = std::fabs(x[k]);
+    m = k == 0 || a > m ? a : m;
+  }
+  return m;
+}
+
 // x = A^-1 b for N = 2, 3 (row-major A) by Cramer's rule, *inv_det = 1 / det A; returns 1.0, or
 // 0.0 when |det| <= 64 eps ||A||_inf^N (numerically singular; x is then unspecified).
 // Branch-free.
@@ -67,9 +81,11 @@ inline double cramer_lane(const double* A, const double* b, double* x, double* i
   for (int r = 0; r < N; ++r) {
     double row = 0.0;
 #pragma GCC unroll 16
-    for (int c = 0; c < N; ++c)
-      row += std::fabs(A[r * N + c]);
-    norm = row > norm ? row : norm;
+    for (int c = 0; c < N; ++c) {
+      const double a = std::fabs(A[r * N + c]);
+      row = c == 0 ? a : row + a;
+    }
+    norm = r == 0 || row > norm ? row : norm;
   }
   double det;
   if constexpr (N == 2)
@@ -96,62 +112,64 @@ template <int N> inline bool cramer_solve(const double* A, const double* b, doub
 
 // Start: base, the better of u and the Euler predictor, its residual; lanes with a non-finite
 // start are bad, lanes with a zero residual are done.
-template <class M, int NS, int NP, int W>
-MG_LANES_WIDE inline void lockstep_start(LockstepLanes<NS, NP, W>& L, double trap, double cdt) {
+template <class M, bool FP, bool Src, int NS, int NP, int W>
+MG_LANES_WIDE inline void lockstep_start(LockstepLanes<NS, NP, W>& L, const double* pconst,
+                                         double trap, double cdt) {
 #pragma GCC ivdep
   for (int l = 0; l < W; ++l) {
     double uc[NS], pc[NP], ru[NS], pred[NS], rp[NS], Fp[NS];
-    lane_inputs(L.u, L.p, l, uc, pc);
+    lane_state(L.u, l, uc);
+    lane_params<FP || M::nparams == 0>(L.p, pconst, l, pc); // no pconst[0] without parameters
     M::rates(uc, pc, ru);
-    double un = 0.0, resp = 0.0, resu = 0.0, fin = 0.0, finu = 0.0; // sums: NaN/inf show there
+    double du[NS], fin = 0.0, finu = 0.0; // sums: NaN/inf show there
 #pragma GCC unroll 16
     for (int s = 0; s < NS; ++s) {
-      const double b = uc[s] + trap * cdt * (ru[s] + L.s0[s][l]);
+      const double b = uc[s] + trap * cdt * plus_source<Src>(ru[s], L.s0[s][l]);
       L.base[s][l] = b;
-      pred[s] = b + cdt * (ru[s] + L.s1[s][l]);
-      const double a = std::fabs(uc[s]);
-      un = a > un ? a : un;
+      pred[s] = b + cdt * plus_source<Src>(ru[s], L.s1[s][l]);
     }
     M::rates(pred, pc, rp);
 #pragma GCC unroll 16
     for (int s = 0; s < NS; ++s) {
-      Fp[s] = pred[s] - L.base[s][l] - cdt * (rp[s] + L.s1[s][l]);
-      const double ap = std::fabs(Fp[s]), au = std::fabs(uc[s] - pred[s]);
-      resp = ap > resp ? ap : resp;
-      resu = au > resu ? au : resu;
+      Fp[s] = pred[s] - L.base[s][l] - cdt * plus_source<Src>(rp[s], L.s1[s][l]);
+      du[s] = uc[s] - pred[s];
       fin += Fp[s];
       finu += uc[s] + pred[s];
     }
+    const double un = lane_max_abs<NS>(uc), resp = lane_max_abs<NS>(Fp),
+                 resu = lane_max_abs<NS>(du);
     const double usep = finite_mask(fin) * (resp < resu ? 1.0 : 0.0);
 #pragma GCC unroll 16
     for (int s = 0; s < NS; ++s) {
       L.v[s][l] = usep != 0.0 ? pred[s] : uc[s];
-      L.F[s][l] = usep != 0.0 ? Fp[s] : uc[s] - pred[s];
+      L.F[s][l] = usep != 0.0 ? Fp[s] : du[s];
     }
     const double res = usep != 0.0 ? resp : resu;
     const double bad = 1.0 - finite_mask(finu);
     L.res[l] = res;
     L.unorm[l] = un;
     L.its[l] = 0.0;
-    L.bad[l] = bad;
     L.done[l] = bad == 0.0 && res == 0.0 ? 1.0 : 0.0;
+    L.act[l] = (1.0 - bad) * (res != 0.0 ? 1.0 : 0.0);
   }
 }
 
 // One full Newton step on every active lane (branch-free: every lane computes, selects keep
 // the finished ones).
-template <class M, int NS, int NP, int W>
-MG_LANES_WIDE MG_LANES_INLINE void lockstep_newton(LockstepLanes<NS, NP, W>& L, double cdt,
-                                                   double tol, double big, double it) {
+template <class M, bool FP, bool Src, int NS, int NP, int W>
+MG_LANES_WIDE MG_LANES_INLINE void lockstep_newton(LockstepLanes<NS, NP, W>& L,
+                                                   const double* pconst, double cdt, double tol,
+                                                   double big, double it) {
 #pragma GCC ivdep
   for (int l = 0; l < W; ++l) {
     double vc[NS], pc[NP], J[NS * NS], rhs[NS], dv[NS], vt[NS], r[NS], Ft[NS];
-    lane_inputs(L.v, L.p, l, vc, pc);
+    lane_state(L.v, l, vc);
+    lane_params<FP || M::nparams == 0>(L.p, pconst, l, pc); // no pconst[0] without parameters
     M::jacobian(vc, pc, J);
 #pragma GCC unroll 16
     for (int q = 0; q < NS * NS; ++q)
       J[q] *= -cdt;
-    double f2 = 0.0, step = 0.0, vcn = 0.0;
+    double f2 = 0.0;
 #pragma GCC unroll 16
     for (int s = 0; s < NS; ++s) {
       J[s * NS + s] += 1.0;
@@ -161,36 +179,28 @@ MG_LANES_WIDE MG_LANES_INLINE void lockstep_newton(LockstepLanes<NS, NP, W>& L, 
     double inv;
     const double regular = cramer_lane<NS>(J, rhs, dv, &inv);
 #pragma GCC unroll 16
-    for (int s = 0; s < NS; ++s) {
+    for (int s = 0; s < NS; ++s)
       vt[s] = vc[s] + dv[s];
-      const double a = std::fabs(dv[s]), c = std::fabs(vc[s]);
-      step = a > step ? a : step;
-      vcn = c > vcn ? c : vcn;
-    }
+    const double step = lane_max_abs<NS>(dv), vcn = lane_max_abs<NS>(vc),
+                 vtn = lane_max_abs<NS>(vt);
     M::rates(vt, pc, r);
-    double rest = 0.0, ft2 = 0.0, vtn = 0.0, fin = 0.0;
+    double ft2 = 0.0, fin = 0.0;
 #pragma GCC unroll 16
     for (int s = 0; s < NS; ++s) {
-      Ft[s] = vt[s] - L.base[s][l] - cdt * (r[s] + L.s1[s][l]);
-      const double a = std::fabs(Ft[s]), b = std::fabs(vt[s]);
-      rest = a > rest ? a : rest;
+      Ft[s] = vt[s] - L.base[s][l] - cdt * plus_source<Src>(r[s], L.s1[s][l]);
       ft2 += Ft[s] * Ft[s];
-      vtn = b > vtn ? b : vtn;
       fin += Ft[s];
     }
+    const double rest = lane_max_abs<NS>(Ft);
     const double un = L.unorm[l];
     const double far = step > big * (1.0 + (un > vcn ? un : vcn)) ? 1.0 : 0.0;
     const double armijo = ft2 <= (1.0 - 2e-4) * f2 ? 1.0 : 0.0;
-    const double act = (1.0 - L.done[l]) * (1.0 - L.bad[l]);
+    const double act = L.act[l];
     const double ok = regular * finite_mask(fin) * (1.0 - far * (1.0 - armijo));
     const double take = act * ok;
-    double ahead[NS], num = 0.0; // A^-1 F(vt) = ahead / det: about the error left in vt
+    double ahead[NS]; // A^-1 F(vt) = ahead / det: about the error left in vt
     cramer_numerators<NS>(J, Ft, ahead);
-#pragma GCC unroll 16
-    for (int s = 0; s < NS; ++s) {
-      const double a = std::fabs(ahead[s]);
-      num = a > num ? a : num;
-    }
+    const double num = lane_max_abs<NS>(ahead);
     const double bound = tol * (1.0 + (un > vtn ? un : vtn));
     const double conv = newton_update_converged_mask(step, num * std::fabs(inv), bound);
     const double res0 = L.res[l], its0 = L.its[l];
@@ -202,8 +212,8 @@ MG_LANES_WIDE MG_LANES_INLINE void lockstep_newton(LockstepLanes<NS, NP, W>& L, 
     }
     L.res[l] = take != 0.0 ? rest : res0;
     L.its[l] = take != 0.0 ? it : its0;
-    L.bad[l] += act * (1.0 - ok);
     L.done[l] += take * conv;
+    L.act[l] = take * (1.0 - conv);
   }
 }
 
@@ -213,7 +223,7 @@ template <int NS, int NP, int W>
 inline bool lockstep_any_active(const LockstepLanes<NS, NP, W>& L) {
   int busy = 0;
   for (int l = 0; l < W; ++l)
-    busy |= static_cast<int>(L.done[l] == 0.0) & static_cast<int>(L.bad[l] == 0.0);
+    busy |= static_cast<int>(L.act[l] != 0.0);
   return busy != 0;
 }
 
@@ -243,12 +253,12 @@ inline void lockstep_store(const LockstepLanes<NS, NP, W>& L, int i0, const doub
 // not depend on the chunk width.
 constexpr int kLockstepLanes = 64;
 
-template <class M, bool FieldParams>
+template <class M, bool FieldParams, bool Src>
 MG_LANES_WIDE inline int
-lockstep_implicit_row(ReactionScheme scheme, int n, const double* const* u,
-                      const double* const* prow, const double* pconst, const double* const* S0,
-                      const double* const* S1, double dt, double tol, int maxit,
-                      const double* floor, double* const* out, CellSolve* worst) {
+lockstep_implicit_row_of(ReactionScheme scheme, int n, const double* const* u,
+                         const double* const* prow, const double* pconst, const double* const* S0,
+                         const double* const* S1, double dt, double tol, int maxit,
+                         const double* floor, double* const* out, CellSolve* worst) {
   constexpr int NS = M::nspecies;
   constexpr int NP = M::nparams > 0 ? M::nparams : 1;
   constexpr int W = kLockstepLanes;
@@ -261,9 +271,9 @@ lockstep_implicit_row(ReactionScheme scheme, int n, const double* const* u,
   for (int i0 = 0; i0 < n; i0 += W) {
     const int w = n - i0 < W ? n - i0 : W;
     lockstep_load<NS, NP, W, FieldParams>(L, i0, w, M::nparams, u, prow, pconst, S0, S1);
-    lockstep_start<M>(L, trap ? 1.0 : 0.0, cdt);
+    lockstep_start<M, FieldParams, Src>(L, pconst, trap ? 1.0 : 0.0, cdt);
     for (int it = 1; it <= maxit && lockstep_any_active(L); ++it)
-      lockstep_newton<M>(L, cdt, tol, big, static_cast<double>(it));
+      lockstep_newton<M, FieldParams, Src>(L, pconst, cdt, tol, big, static_cast<double>(it));
     if (w == W && lockstep_all_done(L)) {
       lockstep_store(L, i0, floor, out, its_max, res_max);
       continue;
@@ -304,6 +314,20 @@ lockstep_implicit_row(ReactionScheme scheme, int n, const double* const* u,
   }
   if (worst) *worst = acc;
   return -1;
+}
+
+// The row with or without sources (S0, S1 null: none; the source-free lanes skip adding zeros).
+template <class M, bool FieldParams>
+MG_LANES_WIDE inline int
+lockstep_implicit_row(ReactionScheme scheme, int n, const double* const* u,
+                      const double* const* prow, const double* pconst, const double* const* S0,
+                      const double* const* S1, double dt, double tol, int maxit,
+                      const double* floor, double* const* out, CellSolve* worst) {
+  if (S0 || S1)
+    return lockstep_implicit_row_of<M, FieldParams, true>(scheme, n, u, prow, pconst, S0, S1, dt,
+                                                          tol, maxit, floor, out, worst);
+  return lockstep_implicit_row_of<M, FieldParams, false>(scheme, n, u, prow, pconst, S0, S1, dt,
+                                                         tol, maxit, floor, out, worst);
 }
 
 } // namespace detail
