@@ -17,6 +17,25 @@ inline void tri_multiply_row(int n, double s0, double s1, const double* a, const
     out[l] = s0 * cur[l] + s1 * ((a[l] * prev[l] + b[l] * cur[l]) + g[l] * next[l]);
 }
 
+// The same product row by row with a x_{j-1} carried, in place: pa holds a prev (the products
+// of the row before, rounded as tri_multiply_row rounds them, so the same values); on return
+// cur holds the product and pa the a cur that the next row needs.
+inline void tri_multiply_row_carry(int n, double s0, double s1, const double* a, const double* b,
+                                   const double* g, double* pa, const double* next, double* cur) {
+  for (int l = 0; l < n; ++l) {
+    const double c = cur[l];
+    const double out = s0 * c + s1 * ((pa[l] + b[l] * c) + g[l] * next[l]);
+    pa[l] = a[l] * c;
+    cur[l] = out;
+  }
+}
+
+// out = a x (the first carried products of tri_multiply_row_carry).
+inline void tri_times_row(int n, const double* a, const double* x, double* out) {
+  for (int l = 0; l < n; ++l)
+    out[l] = a[l] * x[l];
+}
+
 // Forward elimination step: cur = (cur - a prev) inv (prev null: the first row, cur = cur inv).
 inline void tri_forward_row(int n, const double* a, const double* inv, const double* prev,
                             double* cur) {

@@ -192,15 +192,11 @@ const double* TridiagonalSolver::diagonal(PetscInt j) const {
 
 void TridiagonalSolver::multiply(double s0, double s1) {
   exchange_edges();
-  std::vector<double> prev(lo_), cur(static_cast<size_t>(n_));
-  for (PetscInt j = 0; j < m_; ++j) {
-    double* y = row(j);
-    const double* next = j + 1 < m_ ? row(j + 1) : hi_.data();
-    std::copy(y, y + n_, cur.begin());
-    tri_multiply_row(n_, s0, s1, a_.data(), diagonal(j), g_.data(), prev.data(), cur.data(), next,
-                     y);
-    std::swap(prev, cur);
-  }
+  std::vector<double> pa(static_cast<size_t>(n_));
+  tri_times_row(n_, a_.data(), lo_.data(), pa.data());
+  for (PetscInt j = 0; j < m_; ++j)
+    tri_multiply_row_carry(n_, s0, s1, a_.data(), diagonal(j), g_.data(), pa.data(),
+                           j + 1 < m_ ? row(j + 1) : hi_.data(), row(j));
 }
 
 void TridiagonalSolver::factor(double c, double theta) {
@@ -405,8 +401,7 @@ void TridiagonalSolver::down_begin(const PlaneView& in, double s0, double s1) {
   t_->plane_forward(in, 0, row(0));
   t_->plane_forward(in, m_ - 1, row(m_ - 1));
   begin_edges(); // arrive while the planes between are transformed (hi_ used at m - 1, lo_ last)
-  prev_.resize(n);
-  cur_.resize(n);
+  pa_.resize(n);
   raw1_.resize(n);
 }
 
@@ -418,13 +413,12 @@ void TridiagonalSolver::down_plane(const PlaneView& in, PetscInt j) {
         prefetch_doubles(in.base + (j + 3) * in.plane + r * in.row, in.len);
     if (j + 1 < m_ - 1) t_->plane_forward(in, j + 1, row(j + 1));
     if (j == m_ - 1) end_edges();
-    std::copy(y, y + n_, cur_.begin());
-    if (j == 0) // row 0's product waits for lo_ (down_end); row 1 as it is now
+    if (j == 0) { // row 0's product waits for lo_ (down_end); row 1 as it is now
+      tri_times_row(n_, a_.data(), y, pa_.data());
       std::copy(row(1), row(1) + n_, raw1_.begin());
-    else
-      tri_multiply_row(n_, s0_, s1_, a_.data(), diagonal(j), g_.data(), prev_.data(), cur_.data(),
-                       j + 1 < m_ ? row(j + 1) : hi_.data(), y);
-    std::swap(prev_, cur_);
+    } else
+      tri_multiply_row_carry(n_, s0_, s1_, a_.data(), diagonal(j), g_.data(), pa_.data(),
+                             j + 1 < m_ ? row(j + 1) : hi_.data(), y);
   } else {
     t_->plane_forward(in, j, y);
     tri_scale_row(n_, s0_, y);

@@ -143,8 +143,8 @@ private:
   // |a p|, |g q| < 2^-64 in every lane; see truncate_spikes).
   std::vector<double> p_, q_;
   PetscInt kp_ = 0, kq_ = 0;
-  std::vector<double> prev_, cur_, zero_, F_, E_; // one row each
-  std::vector<double> xs_;                        // up()'s two scratch rows
+  std::vector<double> pa_, zero_, F_, E_; // one row each (pa_: down()'s carried a x_{j-1})
+  std::vector<double> xs_;                // up()'s two scratch rows
   std::vector<double> raw1_; // down(): plane 1 before its product (row 0's product needs it)
   bool product_ = false;     // down(): with the explicit product, its scales (1/norm folded in)
   double s0_ = 0.0, s1_ = 0.0;
