@@ -9,17 +9,10 @@
 
 namespace morphogen {
 
-// out = s0 cur + s1 (a prev + b cur + g next) (out may alias cur).
-inline void tri_multiply_row(int n, double s0, double s1, const double* a, const double* b,
-                             const double* g, const double* prev, const double* cur,
-                             const double* next, double* out) {
-  for (int l = 0; l < n; ++l)
-    out[l] = s0 * cur[l] + s1 * ((a[l] * prev[l] + b[l] * cur[l]) + g[l] * next[l]);
-}
-
-// The same product row by row with a x_{j-1} carried, in place: pa holds a prev (the products
-// of the row before, rounded as tri_multiply_row rounds them, so the same values); on return
-// cur holds the product and pa the a cur that the next row needs.
+// The explicit (Crank-Nicolson) product, row by row along the slow axis, in place:
+//   cur <- s0 cur + s1 ((a prev + b cur) + g next),
+// with a prev carried: pa holds a prev on entry (tri_times_row for the first row) and a cur on
+// return, which the next row needs (so a raw row never has to be copied aside).
 inline void tri_multiply_row_carry(int n, double s0, double s1, const double* a, const double* b,
                                    const double* g, double* pa, const double* next, double* cur) {
   for (int l = 0; l < n; ++l) {
@@ -30,7 +23,7 @@ inline void tri_multiply_row_carry(int n, double s0, double s1, const double* a,
   }
 }
 
-// out = a x (the first carried products of tri_multiply_row_carry).
+// out = a x (the first carried products a prev of tri_multiply_row_carry).
 inline void tri_times_row(int n, const double* a, const double* x, double* out) {
   for (int l = 0; l < n; ++l)
     out[l] = a[l] * x[l];

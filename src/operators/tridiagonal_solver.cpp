@@ -428,9 +428,11 @@ void TridiagonalSolver::down_plane(const PlaneView& in, PetscInt j) {
 }
 
 void TridiagonalSolver::down_end() {
-  if (product_) // row 0 is no interior row: the elimination did not use it
-    tri_multiply_row(n_, s0_, s1_, a_.data(), diagonal(0), g_.data(), lo_.data(), row(0),
-                     raw1_.data(), row(0));
+  if (product_) { // row 0 is no interior row: the elimination did not use it
+    tri_times_row(n_, a_.data(), lo_.data(), pa_.data());
+    tri_multiply_row_carry(n_, s0_, s1_, a_.data(), diagonal(0), g_.data(), pa_.data(),
+                           raw1_.data(), row(0));
+  }
 }
 
 // Back substitution of the interior; an interior row the spikes do not reach is final and goes

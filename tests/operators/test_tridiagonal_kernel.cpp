@@ -1,8 +1,9 @@
 // The slow-axis tridiagonal row kernels (operators/tridiagonal_kernel.hpp), serial:
 //  (a) the Crank-Nicolson product plane by plane with a x_{j-1} carried
-//      (tri_times_row, then tri_multiply_row_carry in place) gives bitwise the values of
-//      tri_multiply_row on copies of the raw rows, which TridiagonalSolver used before, for
-//      random rows, per-lane coefficients, distinct first/interior/last diagonals and scales;
+//      (tri_times_row, then tri_multiply_row_carry in place) gives bitwise the values of the
+//      product s0 x_j + s1 ((a x_{j-1} + b_j x_j) + g x_{j+1}) of the raw rows (evaluated here
+//      on copies of them, as TridiagonalSolver did before), for random rows, per-lane
+//      coefficients, distinct first/interior/last diagonals and scales;
 //  (b) Thomas elimination by rows (tri_forward_row, then tri_backward_row with gp = g inv)
 //      solves a diagonally dominant system per lane to 1e-13 relative (residual of the
 //      original equations).
@@ -52,8 +53,12 @@ TEST(TridiagonalKernel, CarriedProductIsBitwiseTheCopiedOne) {
   for (int j = 0; j < m; ++j) {
     cur = ref[static_cast<size_t>(j)];
     const double* next = j + 1 < m ? raw[static_cast<size_t>(j + 1)].data() : hi.data();
-    tri_multiply_row(n, s0, s1, a.data(), diag(j), g.data(), prev.data(), cur.data(), next,
-                     ref[static_cast<size_t>(j)].data());
+    const double* b = diag(j);
+    for (int l = 0; l < n; ++l) {
+      const size_t L = static_cast<size_t>(l);
+      ref[static_cast<size_t>(j)][L] =
+          s0 * cur[L] + s1 * ((a[L] * prev[L] + b[L] * cur[L]) + g[L] * next[L]);
+    }
     prev = cur;
   }
 
