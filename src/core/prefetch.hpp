@@ -1,6 +1,6 @@
 // Software prefetch of a row that a sweep will read from memory a few rows later, so that its
 // loads overlap the arithmetic of the rows before it (the hardware prefetchers of some CPUs do not
-// run far enough ahead of a row-by-row stencil sweep; README, Performance, has the measurements).
+// run far enough ahead of a row-by-row stencil sweep; docs/performance.md has the measurements).
 // One prefetch (into L1, for reading) per cache line; prefetches never fault, and no value read
 // depends on them.
 #pragma once

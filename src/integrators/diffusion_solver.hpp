@@ -42,8 +42,8 @@
 namespace morphogen {
 
 // The exact solve of operator M that -diffusion_slow_axis auto picks: tridiagonal along the
-// slowest axis (except on one rank in 3-D, where the full transform measured faster: README,
-// Performance), else the full transform; null, with *why set, where neither applies.
+// slowest axis (except on one rank in 3-D, where the full transform measured faster:
+// docs/performance.md), else the full transform; null, with *why set, where neither applies.
 std::unique_ptr<ExactSolve> auto_exact_solve(const Grid& grid, Mat M, std::string* why);
 
 class DiffusionSolver {

@@ -98,7 +98,7 @@ public:
   // plane read first two rows later). Box stencils: issued by the row kernel one cache line at
   // a time between its cells (ExplicitRow::prefetch_ahead; 4096^2 9pt 25-30 % faster than the
   // whole row before the call, which stalls on the core's miss buffers); the 5/7-point tap loop
-  // gets the whole row before its call (faster there, README, Performance). Auto where a rank's
+  // gets the whole row before its call (faster there, docs/performance.md). Auto where a rank's
   // state is at least kPrefetchBytes (out of the per-core caches; in cache the prefetches only
   // cost instructions); Always and Never force it. Nothing read changes, so neither do the results.
   // (Fused passes do not prefetch: their rows take k times the arithmetic, which hides the loads
