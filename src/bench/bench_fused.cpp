@@ -65,7 +65,8 @@ FusedSettings read_fused_settings(Options& opt) {
   return fs;
 }
 
-void bench_fused(MPI_Comm comm, Options& opt, const FusedSettings& fs, double roof) {
+void bench_fused(MPI_Comm comm, Options& opt, const FusedSettings& fs, double roof,
+                 const MachineInfo& machine) {
   if (fs.depth.empty()) return;
   const auto& depth = fs.depth;
   const auto& stencil = fs.stencil;
@@ -94,9 +95,9 @@ void bench_fused(MPI_Comm comm, Options& opt, const FusedSettings& fs, double ro
       // Issue 13 part 2: one step per pass, out of cache (2048^2, 4096^2): >= 0.95.
       PetscPrintf(comm,
                   "explicit_fused grid=%sx%s stencil=%s k=1 cell_updates_per_s=%.4e "
-                  "roofline_fraction=%.3f target>=0.95 %s\n",
+                  "roofline_fraction=%.3f target>=0.95 %s%s\n",
                   n.c_str(), n.c_str(), stencil.c_str(), base, base / roof,
-                  base / roof >= 0.95 ? "met" : "NOT met");
+                  base / roof >= 0.95 ? "met" : "NOT met", l3_note(16.0 * cells, machine).c_str());
       for (PetscInt k : depth) {
         if (k < 1 || k > sim.fuse_steps()) continue;
         const PetscInt timed = (steps + k - 1) / k * k;

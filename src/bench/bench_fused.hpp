@@ -7,6 +7,7 @@
 // Simulation per grid, built with the largest k (a pass of n <= k steps is exact for any n).
 #pragma once
 
+#include "bench/bench_machine.hpp"
 #include "core/options.hpp"
 
 #include <string>
@@ -23,6 +24,8 @@ struct FusedSettings {
 };
 FusedSettings read_fused_settings(Options& opt);
 
-void bench_fused(MPI_Comm comm, Options& opt, const FusedSettings& fs, double roof);
+// The k = 1 lines end with the grid's state per node against the machine's L3 (l3_note).
+void bench_fused(MPI_Comm comm, Options& opt, const FusedSettings& fs, double roof,
+                 const MachineInfo& machine);
 
 } // namespace morphogen

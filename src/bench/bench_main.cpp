@@ -23,6 +23,7 @@
 #include "bench/bench_fluids.hpp"
 #include "bench/bench_fused.hpp"
 #include "bench/bench_kernel_rate.hpp"
+#include "bench/bench_machine.hpp"
 #include "bench/bench_output.hpp"
 #include "bench/bench_scaling.hpp"
 #include "bench/bench_scoped_options.hpp"
@@ -530,6 +531,7 @@ int run(MPI_Comm comm) {
   }
   opt.check_unused("bench_"); // a mistyped -bench_* option, before minutes of timings
   hold_integrator_options();  // -explicit_*, -ts_diffusion*: only for runs of their integrator
+  const MachineInfo machine = print_machine(comm);
   if (with_fluids || only_fluids)
     bench_fluids(comm, opt, static_cast<int>(fluids_n), static_cast<int>(fluids_steps));
   if (only_fluids) return 0;
@@ -551,7 +553,7 @@ int run(MPI_Comm comm) {
   if (access_3d_n > 0 && !only_implicit)
     bench_access_pattern_3d(comm, static_cast<int>(access_3d_n), roof);
   if (only_access) return 0;
-  if (!only_implicit) bench_fused(comm, opt, fused, roof);
+  if (!only_implicit) bench_fused(comm, opt, fused, roof, machine);
   if (only_fused) return 0;
   if (with_implicit) {
     bench_reaction_kernel(comm);
@@ -577,8 +579,9 @@ int run(MPI_Comm comm) {
     return n3 < 256 ? std::string("target>=0.85 applies out of cache (-bench_3d_n 256)")
                     : std::string("target>=0.85 ") + (cups / roof >= 0.85 ? "met" : "NOT met");
   };
-  PetscPrintf(comm, "explicit_3d_target grid=%s fraction=%.3f %s\n", name3.c_str(), r3.cups / roof,
-              target3(r3.cups).c_str());
+  const std::string in_l3 = l3_note(16.0 * std::pow(static_cast<double>(n3), 3), machine);
+  PetscPrintf(comm, "explicit_3d_target grid=%s fraction=%.3f %s%s\n", name3.c_str(),
+              r3.cups / roof, target3(r3.cups).c_str(), in_l3.c_str());
   // The kernels alone and the bounds they set, on rows of the grid's side (at most 512 cells:
   // 2 species x 9 rows of 4 KiB, which at 512 already exceed a 48 KiB L1).
   for (const char* st : {"7pt", "19pt", "27pt"})
@@ -589,9 +592,9 @@ int run(MPI_Comm comm) {
         bench_explicit(comm, opt, grid3, static_cast<int>(steps3), {{"-stencil", st}});
     PetscPrintf(comm,
                 "explicit_3d_%s grid=%s model=gray_scott bytes_per_update=32 "
-                "cell_updates_per_s=%.4e fraction=%.3f vs_7pt=%.3f %s\n",
+                "cell_updates_per_s=%.4e fraction=%.3f vs_7pt=%.3f %s%s\n",
                 st, name3.c_str(), rb.cups, rb.cups / roof, rb.cups / r3.cups,
-                target3(rb.cups).c_str());
+                target3(rb.cups).c_str(), in_l3.c_str());
   }
   // The general path (diffusion from per-species operators, then the reaction, row by row):
   // a rotated tensor for both species (reads 3 dual-cell tensor components per species: 80

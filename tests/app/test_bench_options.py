@@ -104,3 +104,44 @@ def test_fused_section_keeps_its_depths(tmp_path):
     ns, cups, frac = (float(ring.group(i)) for i in (1, 2, 3))
     assert ns > 0 and abs(cups - int(ranks.group(1)) / (ns * 1e-9)) <= 1e-3 * cups, p.stdout
     assert abs(frac - cups / r) <= 1e-3 * frac, p.stdout
+
+
+def sys_l3_mib():
+    """The L3 size of cpu0 as Linux lists it (MiB), or None."""
+    base = "/sys/devices/system/cpu/cpu0/cache"
+    if not os.path.isdir(base):
+        return None
+    for d in sorted(os.listdir(base)):
+        try:
+            level = open(os.path.join(base, d, "level")).read().strip()
+            size = open(os.path.join(base, d, "size")).read().strip()
+        except OSError:
+            continue
+        if level == "3":
+            scale = {"K": 1 / 1024, "M": 1, "G": 1024}.get(size[-1], 1 / 1048576)
+            return float(size.rstrip("KMG")) * scale
+    return None
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_machine_line_and_state_against_l3(tmp_path, ranks):
+    """The machine line (CPU, caches, ranks per node) and, on the k = 1 fused line, the grid's
+    state per node against that L3."""
+    p = bench(["-bench_only_fused", "true", "-bench_output_n", "0", "-bench_fuse_n", "64",
+               "-bench_fuse_steps", "0", "-bench_fuse_steps_timed", "8", "-bench_stream_mb", "8",
+               "-bench_access_rows", "0", "-bench_access_3d_n", "0"], tmp_path, ranks, 120)
+    assert p.returncode == 0, p.stderr
+    m = re.search(r'^machine cpu="([^"]*)" logical_cpus=(\d+) l1d_KiB=(\d+) l2_KiB=(\d+) '
+                  r"l3_MiB=(\d+) avx512=(yes|no) nodes=1 ranks_per_node=(\d+)$", p.stdout, re.M)
+    assert m, p.stdout
+    assert int(m.group(2)) == os.sysconf("SC_NPROCESSORS_ONLN") and int(m.group(7)) == ranks
+    l3 = sys_l3_mib()
+    if l3 is not None:
+        assert int(m.group(5)) == round(l3)
+    flags = open("/proc/cpuinfo").read()
+    assert (m.group(6) == "yes") == (" avx512f" in flags)
+    f = re.search(r"^explicit_fused grid=64x64 stencil=9pt k=1 .* state_MiB_per_node=(\S+) "
+                  r"in_l3=(yes|no|unknown)$", p.stdout, re.M)
+    assert f, p.stdout
+    assert float(f.group(1)) == pytest.approx(16 * 64 * 64 / 2**20, rel=1e-3)
+    assert f.group(2) == ("unknown" if not l3 else "yes")
