@@ -97,7 +97,7 @@ void bench_fused(MPI_Comm comm, Options& opt, const FusedSettings& fs, double ro
                   "explicit_fused grid=%sx%s stencil=%s k=1 cell_updates_per_s=%.4e "
                   "roofline_fraction=%.3f target>=0.95 %s%s\n",
                   n.c_str(), n.c_str(), stencil.c_str(), base, base / roof,
-                  base / roof >= 0.95 ? "met" : "NOT met", l3_note(16.0 * cells, machine).c_str());
+                  base / roof >= 0.95 ? "met" : "NOT met", l3_note(cells, machine).c_str());
       for (PetscInt k : depth) {
         if (k < 1 || k > sim.fuse_steps()) continue;
         const PetscInt timed = (steps + k - 1) / k * k;

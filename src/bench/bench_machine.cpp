@@ -106,8 +106,8 @@ MachineInfo print_machine(MPI_Comm comm) {
   return m;
 }
 
-std::string l3_note(double state_bytes, const MachineInfo& m) {
-  const double per_node = state_bytes / (m.nodes > 0 ? m.nodes : 1);
+std::string l3_note(double cells, const MachineInfo& m) {
+  const double per_node = 16.0 * cells / (m.nodes > 0 ? m.nodes : 1);
   char buf[96];
   std::snprintf(buf, sizeof buf, " state_MiB_per_node=%.4g in_l3=%s", per_node / 1048576,
                 m.l3_bytes <= 0          ? "unknown"

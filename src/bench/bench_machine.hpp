@@ -30,8 +30,9 @@ MachineInfo read_machine_info(MPI_Comm comm);
 // Collective: reads the machine and prints its line on rank 0.
 MachineInfo print_machine(MPI_Comm comm);
 
-// " state_MiB_per_node=S in_l3=yes|no" for a grid whose state (all species, all ranks) is
-// state_bytes, spread evenly over m.nodes nodes; in_l3=unknown where the L3 size is unknown.
-std::string l3_note(double state_bytes, const MachineInfo& m);
+// " state_MiB_per_node=S in_l3=yes|no" for the bench's 2-species grids of `cells` cells in double
+// (16 bytes per cell), spread evenly over m.nodes nodes; in_l3=unknown where the L3 size is
+// unknown.
+std::string l3_note(double cells, const MachineInfo& m);
 
 } // namespace morphogen

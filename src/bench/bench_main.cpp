@@ -15,7 +15,9 @@
 // Then (-bench_fuse_steps, bench/bench_fused.hpp): the row kernel alone with its rows in cache
 // and the bounds it sets, the fused wavefront over its ring alone (bench/bench_kernel_rate.hpp),
 // fused explicit steps (temporal blocking)
-// at 2048^2 and 4096^2 against one step per pass and the roofline. Last line:
+// at 2048^2 and 4096^2 against one step per pass and the roofline. First line: the machine
+// (bench/bench_machine.hpp: CPU, caches, nodes; the out-of-cache lines end with the grid's
+// state per node against its L3). Last line:
 //   roofline_fraction=<2-D fraction>
 #include "app/pattern_summary.hpp"
 #include "app/simulation.hpp"
@@ -579,7 +581,7 @@ int run(MPI_Comm comm) {
     return n3 < 256 ? std::string("target>=0.85 applies out of cache (-bench_3d_n 256)")
                     : std::string("target>=0.85 ") + (cups / roof >= 0.85 ? "met" : "NOT met");
   };
-  const std::string in_l3 = l3_note(16.0 * std::pow(static_cast<double>(n3), 3), machine);
+  const std::string in_l3 = l3_note(std::pow(static_cast<double>(n3), 3), machine);
   PetscPrintf(comm, "explicit_3d_target grid=%s fraction=%.3f %s%s\n", name3.c_str(),
               r3.cups / roof, target3(r3.cups).c_str(), in_l3.c_str());
   // The kernels alone and the bounds they set, on rows of the grid's side (at most 512 cells:
