@@ -6,9 +6,12 @@
 #include "core/petsc_handle.hpp"
 #include "core/user_error.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <yaml-cpp/yaml.h>
 
@@ -45,7 +48,8 @@ std::string at_offset(const std::string& name, const std::string& text, size_t p
 }
 
 // Walks a mapping; every key must be a plain name, given once (also once after nested keys are
-// joined with '_' into option names, which `seen` collects across the whole deck).
+// joined with '_' into option names, which `seen` collects across the whole deck, in lower
+// case as PETSc compares them).
 std::string check_map(const YAML::Node& map, const std::string& prefix, const std::string& name,
                       std::map<std::string, YAML::Mark>& seen) {
   for (auto it = map.begin(); it != map.end(); ++it) {
@@ -58,7 +62,10 @@ std::string check_map(const YAML::Node& map, const std::string& prefix, const st
       if (const std::string e = check_map(value, option, name, seen); !e.empty()) return e;
       continue;
     }
-    const auto [prev, fresh] = seen.emplace(option, key.Mark());
+    std::string folded = option; // PETSc's option names ignore case: D_a and d_a are one
+    for (char& c : folded)
+      c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const auto [prev, fresh] = seen.emplace(folded, key.Mark());
     if (!fresh)
       return at(name, key.Mark()) + ": duplicate key " + key.Scalar() + " (option -" + option +
              ", already given at line " + std::to_string(prev->second.line + 1) + ")";
@@ -96,14 +103,69 @@ void insert_yaml(const std::string& option, const std::string& path) {
   insert_file(option, path, true);
 }
 
+bool is_yaml_file(const std::string& option, const std::string& path) {
+  return option == "options_file_yaml" || ends_with(path, ".yaml") || ends_with(path, ".yml");
+}
+
+// (line, option, file) of each -options_file / -options_file_yaml line of a plain options file.
+struct NestedFile {
+  int line;
+  std::string option, path;
+};
+std::vector<NestedFile> nested_files(const std::string& text) {
+  std::vector<NestedFile> out;
+  std::istringstream in(text);
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    std::istringstream words(line.substr(0, line.find('#')));
+    std::string first, path;
+    if ((words >> first) && (first == "-options_file" || first == "-options_file_yaml")) {
+      words >> path;
+      out.push_back({n, first.substr(1), path});
+    }
+  }
+  return out;
+}
+
+// Checks a plain options file and, down its chain, every file its -options_file(_yaml) lines
+// name (PETSc inserts those itself, without our checks): a file that is already being read is
+// a cycle (PETSc would recurse until the stack overflows), and at most 16 levels are taken.
+// `option` prefixes messages ("-options_file ", or the including file's line and option).
+void check_options_file_tree(const std::string& option, const std::string& path,
+                             std::vector<std::string>& chain) {
+  const std::string text = read_file(path, option);
+  const std::string head = option.substr(0, option.size() - 1) + " ";
+  if (const std::string err = check_options_file_text(text, path); !err.empty())
+    throw UserError(head + err);
+  std::error_code ec;
+  chain.push_back(std::filesystem::weakly_canonical(path, ec).string());
+  for (const NestedFile& f : nested_files(text)) {
+    const std::string where = head + path + ":" + std::to_string(f.line) + ": -" + f.option;
+    if (f.path.empty()) throw UserError(where + ": needs a file name");
+    const std::string id = std::filesystem::weakly_canonical(f.path, ec).string();
+    if (std::find(chain.begin(), chain.end(), id) != chain.end())
+      throw UserError(where + " " + f.path +
+                      ": includes a file that is already being read (a cycle)");
+    if (chain.size() >= 16)
+      throw UserError(where + " " + f.path + ": options files nested more than 16 deep");
+    if (!is_yaml_file(f.option, f.path)) {
+      check_options_file_tree(where + " ", f.path, chain);
+      continue;
+    }
+    if (const std::string err = check_deck_text(read_file(f.path, where + " "), f.path);
+        !err.empty())
+      throw UserError(where + " " + err);
+  }
+  chain.pop_back();
+}
+
 // -options_file / -options_file_yaml: YAML when so named or when the file ends in .yaml/.yml
 // (as PETSc decides), else PETSc's plain "-option value" format.
 void insert_options_file(const OptionsFileArg& f) {
   const std::string option = "-" + f.option + " ";
-  if (f.option == "options_file_yaml" || ends_with(f.path, ".yaml") || ends_with(f.path, ".yml"))
-    return insert_yaml(option, f.path);
-  const std::string err = check_options_file_text(read_file(f.path, option), f.path);
-  if (!err.empty()) throw UserError(option.substr(0, option.size() - 1) + " " + err);
+  if (is_yaml_file(f.option, f.path)) return insert_yaml(option, f.path);
+  std::vector<std::string> chain;
+  check_options_file_tree(option, f.path, chain);
   insert_file(option, f.path, false);
 }
 
@@ -139,6 +201,38 @@ void refuse_stray_words(int argc, char** argv, int first) {
     throw UserError("'" + std::string(argv[i]) + "'" + (last.empty() ? "" : " after " + last) +
                     ": not an option name and not an option's value (options are -name value; "
                     "quote a value that has spaces, e.g. -init_a \"4 + x\")");
+  }
+}
+
+// PETSc's logging options, read at PetscInitialize from the command line only (PetscFinalize
+// then fails on a -log_view that a deck or options file added): name -> value, or nullopt.
+using LogOptions = std::vector<std::pair<std::string, std::optional<std::string>>>;
+LogOptions log_options() {
+  LogOptions out;
+  for (const char* name : {"-log_view", "-log_trace", "-log_all", "-log_summary", "-log_exclude"}) {
+    const char* value = nullptr;
+    PetscBool set = PETSC_FALSE;
+    MG_PETSC(PetscOptionsFindPair(nullptr, nullptr, name, &value, &set));
+    out.emplace_back(name, set ? std::optional<std::string>(value ? value : "") : std::nullopt);
+  }
+  return out;
+}
+
+// Refuses a logging option that the deck or an options file set or changed, after putting the
+// command line's back (so that PetscFinalize does not fail on it).
+void refuse_file_log_options(const LogOptions& before) {
+  const LogOptions after = log_options();
+  for (size_t i = 0; i < before.size(); ++i) {
+    if (after[i].second == before[i].second) continue;
+    const std::string& name = before[i].first;
+    if (before[i].second)
+      MG_PETSC(PetscOptionsSetValue(nullptr, name.c_str(), before[i].second->c_str()));
+    else
+      MG_PETSC(PetscOptionsClearValue(nullptr, name.c_str()));
+    throw UserError(name + " " + shown(after[i].second.value_or("")) +
+                    " (in the deck or an options file): PETSc reads its logging options from "
+                    "the command line only; give " +
+                    name + " there");
   }
 }
 
@@ -182,6 +276,7 @@ std::string check_options_file_text(const std::string& text, const std::string& 
 
 std::string load_deck(int* argc, char*** argv, const std::vector<OptionsFileArg>& files) {
   std::string deck, base_dir;
+  const LogOptions logging = log_options();
   if (*argc > 1 && (*argv)[1][0] != '-') deck = (*argv)[1];
   refuse_late_deck(*argc, *argv);
   refuse_stray_words(*argc, *argv, deck.empty() ? 1 : 2);
@@ -196,6 +291,7 @@ std::string load_deck(int* argc, char*** argv, const std::vector<OptionsFileArg>
   }
   for (const auto& f : files)
     insert_options_file(f);
+  refuse_file_log_options(logging);
   // The command line overrides the deck and the options files.
   MG_PETSC(PetscOptionsInsert(nullptr, argc, argv, nullptr));
   check_solver_option_values();

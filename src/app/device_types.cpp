@@ -1,5 +1,6 @@
 #include "app/device_types.hpp"
 
+#include "core/options.hpp"
 #include "core/user_error.hpp"
 
 #include <algorithm>
@@ -20,11 +21,11 @@ void read_type(Options& opt, const std::string& name, const std::string& def,
   const std::string v = opt.string(name, def, help);
   if (std::find(host.begin(), host.end(), v) != host.end()) return;
   if (std::find(device.begin(), device.end(), v) != device.end())
-    throw UserError("-" + name + " " + v + ": " + kGpuHowTo);
+    throw UserError("-" + name + " " + shown(v) + ": " + kGpuHowTo);
   std::string allowed;
   for (const auto& h : host)
     allowed += (allowed.empty() ? "" : ", ") + h;
-  throw UserError("-" + name + " " + v + ": unknown type, allowed " + allowed);
+  throw UserError("-" + name + " " + shown(v) + ": unknown type, allowed " + allowed);
 }
 
 } // namespace

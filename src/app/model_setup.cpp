@@ -47,6 +47,7 @@ ModelInfo read_custom(Options& opt, int layers) {
                     "(-rate_a EXPR, -rate_b EXPR)");
   spec.species = opt.list("species", {}, 1, kMaxRuntimeSpecies,
                           "species of the custom model, comma-separated (e.g. a,b)");
+  check_species(spec);
   for (const auto& s : spec.species) {
     const std::string key = "rate_" + s;
     const auto text = opt.get(key, "rate of " + s +

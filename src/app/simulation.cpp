@@ -22,6 +22,9 @@ namespace morphogen {
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kMaxReal = std::numeric_limits<double>::max(); // finite upper bound
+// The largest dt as a multiple of the explicit diffusion bound that the implicit integrators take:
+// far past it, 1 + dt D rho(L) / 2 has lost the 1 (the cell's own value) to rounding.
+constexpr double kMaxDiffusionNumber = 1e12;
 
 // Per species: why its diffusion matrix is re-assembled during the run ("" if it is not), for
 // the split solver's choice of KSP over the spectral solve.
@@ -410,9 +413,19 @@ void Simulation::read_time(Options& opt) {
           " stencil, D_max = " + format_number(*std::max_element(D_.begin(), D_.end())) +
           "); use a smaller -dt, -integrator split (unconditionally stable "
           "diffusion), or -force_dt");
+  } else if (const double ratio = dt_ / stable_dt_; ratio > kMaxDiffusionNumber) {
+    // (stable_dt_ is 0 where h^2 underflows: the ratio is then inf; +inf without diffusion)
+    throw UserError("-dt " + format_number(dt_) + ": " + format_number(ratio) +
+                    " times the explicit diffusion stability bound " + format_number(stable_dt_) +
+                    ", allowed at most " + format_number(kMaxDiffusionNumber) +
+                    " times (beyond it the implicit diffusion solves lose the cell's own value "
+                    "to rounding); use a smaller -dt or D, or a coarser grid");
   }
   steps_ =
       opt.integer("steps", 1000, 0, std::numeric_limits<PetscInt>::max(), "number of time steps");
+  if (!std::isfinite(static_cast<double>(steps_) * dt_))
+    throw UserError("-dt " + format_number(dt_) + ": the end time -steps " +
+                    std::to_string(steps_) + " times -dt overflows a double");
   stepper_ = integrator_.get();
   if (ts_) read_ts(opt);
   if (split_) read_split(opt);
@@ -573,8 +586,10 @@ void Simulation::read_output(Options& opt) {
     }
     const auto r = opt.list(key, {}, 2, 2, "colour range lo,hi of " + species_[s] + " images");
     out_.png_range[s] = {Options::parse_real(key, r[0]), Options::parse_real(key, r[1])};
-    if (!(out_.png_range[s][0] < out_.png_range[s][1]))
-      throw UserError("-" + key + " " + r[0] + "," + r[1] + ": needs lo < hi");
+    const double lo = out_.png_range[s][0], hi = out_.png_range[s][1];
+    if (!(std::isfinite(lo) && std::isfinite(hi) && std::isfinite(hi - lo) && lo < hi))
+      throw UserError("-" + key + " " + r[0] + "," + r[1] +
+                      ": needs finite lo < hi (with a finite hi - lo)");
   }
   out_.progress_every =
       opt.integer("progress_every", std::max<PetscInt>(1, steps_ / 20), 1,
@@ -596,6 +611,11 @@ void Simulation::read_snapshot_options(Options& opt) {
                                   "qrstuvwxyz0123456789_-.") != std::string::npos)
     throw UserError("-output_name " + out_.name +
                     ": allowed characters are letters, digits, '_', '-' and '.'");
+  // Checkpoints are checkpoint_<step>.vtkhdf (io/checkpoint_files.cpp), snapshots
+  // <name>_<step>.vtkhdf: one name for both would overwrite (and prune) each other.
+  if (out_.name == "checkpoint")
+    throw UserError("-output_name checkpoint: reserved for the checkpoint files "
+                    "(checkpoint_<step>.vtkhdf); choose another run name");
   // File names are NAME_<step>.vtkhdf and the like (and MPI-IO adds its own suffixes): keep
   // them well inside the file system's 255-byte limit.
   if (out_.name.size() > 200)

@@ -60,7 +60,7 @@ void check_solver_option_values() {
   for (const auto& [name, value] : all_petsc_options())
     for (const Rule& r : kRules)
       if ((name == r.suffix || ends_with(name, std::string("_") + r.suffix)) && breaks(r, value))
-        throw UserError("-" + name + " " + value + ": out of range, " + r.allowed);
+        throw UserError("-" + name + " " + shown(value) + ": out of range, " + r.allowed);
 }
 
 } // namespace morphogen

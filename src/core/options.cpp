@@ -80,6 +80,13 @@ std::vector<std::pair<std::string, std::string>> all_petsc_options() {
   return all;
 }
 
+std::string shown(const std::string& value) {
+  bool plain = !value.empty();
+  for (unsigned char c : value)
+    plain = plain && c > ' ' && c != 127 && c != '"';
+  return plain ? value : "\"" + value + "\"";
+}
+
 std::string name_petsc_option_error(const std::string& prefix, const std::string& petsc_message) {
   const std::string msg = one_line(petsc_message);
   for (const auto& [name, value] : all_petsc_options()) {
@@ -91,7 +98,7 @@ std::string name_petsc_option_error(const std::string& prefix, const std::string
                        : msg.find("integer value") != std::string::npos ? "not an integer"
                        : msg.find("logical value") != std::string::npos ? "not true or false"
                                                                         : "refused";
-    return "-" + name + " " + value + ": " + what + " (PETSc: " + msg + ")";
+    return "-" + name + " " + shown(value) + ": " + what + " (PETSc: " + msg + ")";
   }
   return {};
 }
@@ -161,12 +168,15 @@ double Options::parse_real(const std::string& name, const std::string& text) {
   errno = 0;
   char* end = nullptr;
   const double v = std::strtod(text.c_str(), &end);
+  const bool none = end == text.c_str(); // nothing read: "", " ", "abc"
   while (end && *end == ' ')
     ++end;
-  // (no hexadecimal "0x10", which strtod would take: integers and expressions refuse it too)
-  if (text.empty() || !end || *end != '\0' || errno == ERANGE || std::isnan(v) ||
+  // (no hexadecimal "0x10", which strtod would take: integers and expressions refuse it too;
+  // an underflow, 1e-320 or 1e-400, reads as the subnormal or 0 that strtod gives, for the
+  // option's range to judge; an overflow is no number)
+  if (none || !end || *end != '\0' || (errno == ERANGE && std::isinf(v)) || std::isnan(v) ||
       text.find_first_of("xX") != std::string::npos)
-    throw UserError("-" + name + " " + text + ": not a number");
+    throw UserError("-" + name + " " + shown(text) + ": not a number");
   return v;
 }
 
@@ -174,12 +184,13 @@ PetscInt Options::parse_int(const std::string& name, const std::string& text) {
   errno = 0;
   char* end = nullptr;
   const long long v = std::strtoll(text.c_str(), &end, 10);
+  const bool none = end == text.c_str(); // nothing read: "", " ", "abc"
   while (end && *end == ' ')
     ++end;
-  if (text.empty() || !end || *end != '\0' || errno == ERANGE)
-    throw UserError("-" + name + " " + text + ": not an integer");
+  if (none || !end || *end != '\0' || errno == ERANGE)
+    throw UserError("-" + name + " " + shown(text) + ": not an integer");
   if (v > std::numeric_limits<PetscInt>::max() || v < std::numeric_limits<PetscInt>::min())
-    throw UserError("-" + name + " " + text + ": out of range, allowed [" +
+    throw UserError("-" + name + " " + shown(text) + ": out of range, allowed [" +
                     std::to_string(std::numeric_limits<PetscInt>::min()) + ", " +
                     std::to_string(std::numeric_limits<PetscInt>::max()) + "]");
   return static_cast<PetscInt>(v);
@@ -191,7 +202,7 @@ double Options::real(const std::string& name, double def, double lo, double hi,
   auto s = get(name, h);
   const double v = s ? parse_real(name, *s) : def;
   if (!(v >= lo && v <= hi))
-    throw UserError("-" + name + " " + (s ? *s : format_number(v)) + ": out of range, " +
+    throw UserError("-" + name + " " + (s ? shown(*s) : format_number(v)) + ": out of range, " +
                     allowed_range(lo, hi));
   record(name, format_double(v), h);
   return v;
@@ -203,7 +214,7 @@ PetscInt Options::integer(const std::string& name, PetscInt def, PetscInt lo, Pe
   auto s = get(name, h);
   const PetscInt v = s ? parse_int(name, *s) : def;
   if (v < lo || v > hi)
-    throw UserError("-" + name + " " + (s ? *s : std::to_string(v)) + ": out of range, " +
+    throw UserError("-" + name + " " + (s ? shown(*s) : std::to_string(v)) + ": out of range, " +
                     int_range(lo, hi));
   record(name, std::to_string(v), h);
   return v;
@@ -221,7 +232,7 @@ bool Options::flag(const std::string& name, bool def, const std::string& help) {
     else if (t == "false" || t == "0" || t == "no" || t == "off")
       v = false;
     else
-      throw UserError("-" + name + " " + *s + ": not a boolean, allowed true or false");
+      throw UserError("-" + name + " " + shown(*s) + ": not a boolean, allowed true or false");
   }
   record(name, v ? "true" : "false", h);
   return v;
@@ -248,7 +259,7 @@ std::string Options::choice(const std::string& name, const std::string& def,
     size_t bd = 4;
     for (auto& a : allowed)
       if (size_t d = edit_distance(v, a); d < bd) bd = d, best = a;
-    throw UserError("-" + name + " " + v + ": unknown, allowed " + all +
+    throw UserError("-" + name + " " + shown(v) + ": unknown, allowed " + all +
                     (best.empty() ? "" : " (did you mean " + best + "?)"));
   }
   record(name, v, h);
@@ -274,7 +285,7 @@ std::vector<std::string> Options::list(const std::string& name, const std::vecto
     v = def;
   }
   if (v.size() < min_count || v.size() > max_count)
-    throw UserError("-" + name + " " + (s ? *s : "") + ": expected " +
+    throw UserError("-" + name + " " + shown(s ? *s : "") + ": expected " +
                     (min_count == max_count
                          ? std::to_string(min_count)
                          : std::to_string(min_count) + " to " + std::to_string(max_count)) +

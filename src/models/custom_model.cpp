@@ -8,6 +8,7 @@
 #include <muParser.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <limits>
 #include <set>
@@ -117,25 +118,6 @@ struct Expressions {
   std::vector<std::unique_ptr<mu::Parser>> jparsers; // d R_s / d u_q, row-major; empty: FD
 };
 
-void check_species(const CustomKinetics& spec) {
-  if (spec.species.empty())
-    throw UserError("-species: the custom model needs its species, e.g. -species a,b");
-  std::set<std::string> seen;
-  for (const auto& n : spec.species) {
-    if (!is_identifier(n) || kReserved.count(n))
-      throw UserError("-species " + n +
-                      ": not a usable species name (letters, digits and _, starting with a "
-                      "letter; not x, y, z, t or pi)");
-    if (!seen.insert(n).second) throw UserError("-species " + n + ": given twice");
-  }
-  if (spec.species.size() > static_cast<size_t>(kMaxModelSpecies))
-    throw UserError("-species: " + std::to_string(spec.species.size()) +
-                    " species, allowed at most " + std::to_string(kMaxModelSpecies));
-  const size_t nj = spec.species.size() * spec.species.size();
-  if (!spec.jac.empty() && (spec.jac.size() != nj || spec.jac_keys.size() != nj))
-    throw UserError("-jac_*: give all " + std::to_string(nj) + " Jacobian entries or none");
-}
-
 // Parses one expression (key: its option in messages) and adds the names in it that are not
 // species to params.
 std::unique_ptr<mu::Parser> parse_one(const std::string& text, const std::string& key,
@@ -191,6 +173,32 @@ void bind_all(const CustomKinetics& spec, const std::vector<std::string>& all, E
 }
 
 } // namespace
+
+void check_species(const CustomKinetics& spec) {
+  if (spec.species.empty())
+    throw UserError("-species: the custom model needs its species, e.g. -species a,b");
+  std::set<std::string> seen;
+  for (const auto& n : spec.species) {
+    if (!is_identifier(n) || kReserved.count(n))
+      throw UserError("-species " + n +
+                      ": not a usable species name (letters, digits and _, starting with a "
+                      "letter; not x, y, z, t or pi)");
+    std::string folded = n;
+    for (char& c : folded)
+      c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (!seen.insert(folded).second)
+      throw UserError("-species " + n +
+                      ": given twice (species names are compared ignoring "
+                      "case, as option names like -D_" +
+                      n + " are)");
+  }
+  if (spec.species.size() > static_cast<size_t>(kMaxModelSpecies))
+    throw UserError("-species: " + std::to_string(spec.species.size()) +
+                    " species, allowed at most " + std::to_string(kMaxModelSpecies));
+  const size_t nj = spec.species.size() * spec.species.size();
+  if (!spec.jac.empty() && (spec.jac.size() != nj || spec.jac_keys.size() != nj))
+    throw UserError("-jac_*: give all " + std::to_string(nj) + " Jacobian entries or none");
+}
 
 ModelInfo custom_model(const CustomKinetics& spec) {
   check_species(spec);

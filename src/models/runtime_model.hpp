@@ -43,5 +43,9 @@ struct CustomKinetics {
   std::vector<std::string> jac = {}, jac_keys = {};
 };
 ModelInfo custom_model(const CustomKinetics& spec);
+// The species names of spec (UserError unless each is an identifier other than x, y, z, t, pi,
+// named once even ignoring case, as PETSc's option names -rate_<s> and -D_<s> do, and there are
+// at most kMaxModelSpecies); custom_model checks them first too.
+void check_species(const CustomKinetics& spec);
 
 } // namespace morphogen

@@ -65,6 +65,11 @@ DECKS = [
      [r"bad\.yaml:3:1: duplicate key grid_n \(option -grid_n, already given at line 2\)"]),
     ("second_document", "steps: 1\n---\nsteps: 2\n", [r"bad\.yaml:\d+:\d+: a second YAML document"]),
     ("nul", "steps: 1\nmo\0del: turing\n", [r"bad\.yaml:2:3: NUL byte"]),
+    ("duplicate_ignoring_case", "D: {a: 0.0625}\nd: {a: 5}\n",
+     [r"bad\.yaml:2:5: duplicate key a \(option -d_a, already given at line 1\)"]),
+    ("log_view", "log_view: \":/nonexistent/x.txt\"\n",
+     [r"-log_view :/nonexistent/x.txt \(in the deck or an options file\): PETSc reads its "
+      r"logging options from the command line only"]),
     ("empty", "", [r"bad\.yaml:1:1: empty deck"]),
     ("comments_only", "# nothing\n   # here\n\n", [r"bad\.yaml:1:1: empty deck"]),
 ]
@@ -94,6 +99,71 @@ def test_bad_options_file(ranks, previous_run, tmp_path):
     one_error(run(["-options_file", "o.yaml", "-output_dir", str(previous_run)], cwd=tmp_path,
                   ranks=ranks), "o.yaml:2:1: duplicate key steps")
     one_error(run(["-options_file"], cwd=tmp_path, ranks=ranks), "-options_file: needs a file name")
+    assert snapshot(previous_run) == before
+
+
+NESTED = [  # (files, the options file given, the error's text)
+    ({"self.txt": "-options_file self.txt\n"}, "self.txt",
+     "-options_file self.txt:1: -options_file self.txt: includes a file that is already being "
+     "read (a cycle)"),
+    ({"m1.txt": "-options_file m2.txt\n", "m2.txt": "-steps 2\n-options_file m1.txt\n"},
+     "m1.txt", "m2.txt:2: -options_file m1.txt: includes a file"),
+    ({"dup.yaml": "model: turing\nmodel: gray_scott\n", "y.txt": "-options_file_yaml dup.yaml\n"},
+     "y.txt", "-options_file_yaml dup.yaml:2:1: duplicate key model"),
+    ({"bin.yaml": "a\0b", "b.txt": "-options_file bin.yaml\n"}, "b.txt", "bin.yaml:1:2: NUL byte"),
+    ({"lv.txt": "-log_view :x.txt:ascii_bogus\n"}, "lv.txt",
+     "-log_view :x.txt:ascii_bogus (in the deck or an options file)"),
+]
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_nested_options_files(ranks, previous_run, tmp_path):
+    """Files named inside an options file (PETSc inserts them itself) get the same checks; a
+    cycle is an error, not a stack overflow."""
+    before = snapshot(previous_run)
+    for files, given, needle in NESTED:
+        for name, text in files.items():
+            (tmp_path / name).write_bytes(text.encode())
+        one_error(run(["-options_file", given, "-output_dir", str(previous_run)], cwd=tmp_path,
+                      ranks=ranks), needle)
+    assert snapshot(previous_run) == before
+    (tmp_path / "inner.txt").write_text("-steps 3\n")
+    (tmp_path / "outer.txt").write_text("-options_file inner.txt\n-grid_n 16,16\n")
+    r = run(["-options_file", "outer.txt", "-png_every", "0", "-output_dir", "o"], cwd=tmp_path,
+            ranks=ranks)
+    assert r.returncode == 0, r.stderr
+    assert "grid 16x16" in r.stdout and "3 steps" in r.stdout, r.stdout
+
+
+BAD_VALUES = [
+    (["-steps", " "], '-steps " ": not an integer'),
+    (["-seed", "  "], '-seed "  ": not an integer'),
+    (["-dt", " "], '-dt " ": not a number'),
+    (["-integrator", "ts "], '-integrator "ts ": unknown, allowed explicit, split, ts'),
+    (["-output_name", "checkpoint"], "-output_name checkpoint: reserved for the checkpoint files"),
+    (["-png_range_a", "-inf,inf"], "-png_range_a -inf,inf: needs finite lo < hi"),
+    (["-png_range_a", "-1e308,1e308"], "-png_range_a -1e308,1e308: needs finite lo < hi"),
+    (["-model", "custom", "-species", "A,a", "-rate_A", "1", "-rate_a", "0 - 5*a"],
+     "-species a: given twice (species names are compared ignoring case"),
+    (["-model", "custom", "-species", "a,a", "-rate_a", "1"], "-species a: given twice"),
+    (["-integrator", "split", "-D_a", "1e20"],
+     "-dt 0.5: 2e+20 times the explicit diffusion stability bound 2.5e-21, allowed at most 1e+12"),
+    (["-integrator", "split", "-grid_L", "1e-160"], "-dt 0.5: inf times the explicit diffusion"),
+    (["-integrator", "ts", "-D_a", "1e20"], "allowed at most 1e+12 times"),
+    (["-integrator", "ts", "-ts_diffusion", "explicit", "-force_dt", "-dt", "1e308", "-steps",
+      "10"], "-dt 1e+308: the end time -steps 10 times -dt overflows a double"),
+]
+
+
+@pytest.mark.parametrize("case", BAD_VALUES, ids=[" ".join(c[0]) for c in BAD_VALUES])
+def test_bad_values(case, previous_run, tmp_path):
+    """Blank numbers, names that clash with other files or ignoring case, a colour range without
+    a finite width, a diffusion number the implicit solves cannot resolve, an end time that
+    overflows: one line, nothing written."""
+    args, needle = case
+    before = snapshot(previous_run)
+    one_error(run(["-grid_n", "16,16", "-steps", "2"] + args + ["-output_dir", str(previous_run)],
+                  cwd=tmp_path), needle)
     assert snapshot(previous_run) == before
 
 
