@@ -100,6 +100,13 @@ std::shared_ptr<const ModelEntry> read_model_choice(Options& opt) {
     return std::shared_ptr<const ModelEntry>(find_model(name), [](const ModelEntry*) {});
   const ModelInfo base =
       name == "custom" ? read_custom(opt, static_cast<int>(layers)) : ModelInfo(*find_model(name));
+  if (base.nspecies * layers > kMaxRuntimeSpecies)
+    throw UserError(
+        "-layers " + std::to_string(layers) + ": " + std::to_string(layers) + " layers of " + name +
+        "'s " + std::to_string(base.nspecies) + " species make " +
+        std::to_string(base.nspecies * layers) + ", allowed at most " +
+        std::to_string(kMaxRuntimeSpecies) + " species (-layers " +
+        std::to_string(std::max(1, kMaxRuntimeSpecies / base.nspecies)) + " or fewer here)");
   return runtime_entry(layers > 1 ? layered_model(base, static_cast<int>(layers)) : base);
 }
 

@@ -2,6 +2,7 @@
 
 #include "core/collective_error.hpp"
 #include "core/options.hpp"
+#include "core/petsc_handle.hpp"
 #include "core/user_error.hpp"
 #include "io/checkpoint_files.hpp"
 
@@ -183,6 +184,30 @@ void check_restart_grid(const Simulation& sim, const RestartPoint& rp) {
   if (!why.empty()) throw UserError("-restart " + rp.path + ": " + why);
 }
 
+namespace {
+
+// "" if every value of the state (ghosts refreshed) is finite on this rank, else the first
+// species that is not, with the value: a checkpoint that holds a NaN or an infinity is refused
+// at the start instead of being reported as a divergence later.
+std::string non_finite_state(Simulation& sim) {
+  for (size_t s = 0; s < sim.state().size(); ++s) {
+    const PetscScalar* a = nullptr;
+    PetscInt n = 0;
+    MG_PETSC(VecGetLocalSize(sim.state()[s], &n));
+    MG_PETSC(VecGetArrayRead(sim.state()[s], &a));
+    double bad = 0;
+    for (PetscInt i = 0; i < n && std::isfinite(bad); ++i)
+      bad = std::isfinite(a[i]) ? 0.0 : a[i];
+    MG_PETSC(VecRestoreArrayRead(sim.state()[s], &a));
+    if (!std::isfinite(bad))
+      return "species " + sim.species()[s] + " holds a non-finite value (" + format_number(bad) +
+             ")";
+  }
+  return {};
+}
+
+} // namespace
+
 void restore(Simulation& sim, const RestartPoint& rp) {
   check_restart_grid(sim, rp);
   std::vector<Vec> fields;
@@ -207,6 +232,8 @@ void restore(Simulation& sim, const RestartPoint& rp) {
   }
   sim.set_clock(rp.time, static_cast<PetscInt>(rp.step));
   sim.refresh_ghosts();
+  const std::string bad = non_finite_state(sim);
+  throw_if_any(sim.grid().comm(), bad.empty() ? bad : "-restart " + rp.path + ": " + bad);
 }
 
 } // namespace morphogen

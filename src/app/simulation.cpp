@@ -388,8 +388,8 @@ void Simulation::read_time(Options& opt) {
   stable_dt_ = (constant ? ExplicitIntegrator::stable_dt(stencil_, D_) : terms_.stable_dt()) /
                static_cast<double>(level_factor_ * level_factor_);
   const double def_dt = std::isfinite(stable_dt_) ? 0.9 * stable_dt_ : 1.0;
-  dt_ = opt.real("dt", def_dt, 0.0, kMaxReal, "time step");
-  if (!(dt_ > 0)) throw UserError("-dt " + format_number(dt_) + ": must be > 0");
+  // (at least the smallest normal double: a subnormal step reads as 0 where subnormals flush)
+  dt_ = opt.real("dt", def_dt, std::numeric_limits<double>::min(), kMaxReal, "time step");
   if (!split_ && !(ts_ && ts_implicit_diffusion_)) {
     const bool force = opt.flag("force_dt", false,
                                 "run even when -dt exceeds the explicit diffusion stability bound");

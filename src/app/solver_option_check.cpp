@@ -38,6 +38,9 @@ const Rule kRules[] = {
     {"snes_atol", 0, kBig, false, false, false, "allowed a finite number >= 0"},
     {"snes_stol", 0, kBig, false, false, false, "allowed a finite number >= 0"},
     {"snes_max_it", 0, kBig, false, false, true, "allowed an integer >= 0"},
+    {"ts_theta_theta", 0, 1, false, false, false, "allowed [0, 1]"},
+    {"ts_max_snes_failures", -1, kBig, false, false, true, "allowed an integer >= -1 (-1: any)"},
+    {"ts_max_reject", -1, kBig, false, false, true, "allowed an integer >= -1 (-1: any)"},
 };
 
 bool ends_with(const std::string& a, const std::string& e) {

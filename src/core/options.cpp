@@ -180,19 +180,19 @@ double Options::parse_real(const std::string& name, const std::string& text) {
   return v;
 }
 
-PetscInt Options::parse_int(const std::string& name, const std::string& text) {
+PetscInt Options::parse_int(const std::string& name, const std::string& text, PetscInt lo,
+                            PetscInt hi) {
   errno = 0;
   char* end = nullptr;
   const long long v = std::strtoll(text.c_str(), &end, 10);
   const bool none = end == text.c_str(); // nothing read: "", " ", "abc"
   while (end && *end == ' ')
     ++end;
-  if (none || !end || *end != '\0' || errno == ERANGE)
+  if (none || !end || *end != '\0')
     throw UserError("-" + name + " " + shown(text) + ": not an integer");
-  if (v > std::numeric_limits<PetscInt>::max() || v < std::numeric_limits<PetscInt>::min())
-    throw UserError("-" + name + " " + shown(text) + ": out of range, allowed [" +
-                    std::to_string(std::numeric_limits<PetscInt>::min()) + ", " +
-                    std::to_string(std::numeric_limits<PetscInt>::max()) + "]");
+  if (errno == ERANGE || v > std::numeric_limits<PetscInt>::max() ||
+      v < std::numeric_limits<PetscInt>::min())
+    throw UserError("-" + name + " " + shown(text) + ": out of range, " + int_range(lo, hi));
   return static_cast<PetscInt>(v);
 }
 
@@ -212,7 +212,7 @@ PetscInt Options::integer(const std::string& name, PetscInt def, PetscInt lo, Pe
                           const std::string& help) {
   const std::string h = help + " (" + int_range(lo, hi) + ")";
   auto s = get(name, h);
-  const PetscInt v = s ? parse_int(name, *s) : def;
+  const PetscInt v = s ? parse_int(name, *s, lo, hi) : def;
   if (v < lo || v > hi)
     throw UserError("-" + name + " " + (s ? shown(*s) : std::to_string(v)) + ": out of range, " +
                     int_range(lo, hi));

@@ -71,7 +71,10 @@ public:
   std::string to_yaml(const std::string& header) const;
 
   static double parse_real(const std::string& name, const std::string& text);
-  static PetscInt parse_int(const std::string& name, const std::string& text);
+  // (lo, hi: the range an integer beyond PetscInt's is refused with; default PetscInt's own)
+  static PetscInt parse_int(const std::string& name, const std::string& text,
+                            PetscInt lo = std::numeric_limits<PetscInt>::min(),
+                            PetscInt hi = std::numeric_limits<PetscInt>::max());
 
 private:
   void record(const std::string& name, const std::string& value, const std::string& help);

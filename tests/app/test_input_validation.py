@@ -152,6 +152,16 @@ BAD_VALUES = [
     (["-integrator", "ts", "-D_a", "1e20"], "allowed at most 1e+12 times"),
     (["-integrator", "ts", "-ts_diffusion", "explicit", "-force_dt", "-dt", "1e308", "-steps",
       "10"], "-dt 1e+308: the end time -steps 10 times -dt overflows a double"),
+    (["-dt", "1e-320"], "-dt 1e-320: out of range, allowed >= 2.22507e-308"),
+    (["-dt", "0"], "-dt 0: out of range, allowed >= 2.22507e-308"),
+    (["-layers", "16"], "-layers 16: 16 layers of turing's 2 species make 32, allowed at most 16 "
+     "species (-layers 8 or fewer here)"),
+    (["-layers", "2147483648"], "-layers 2147483648: out of range, allowed [1, 16]"),
+    (["-steps", "99999999999999999999"], "-steps 99999999999999999999: out of range, allowed >= 0"),
+    (["-integrator", "ts", "-ts_type", "theta", "-ts_theta_theta", "2"],
+     "-ts_theta_theta 2: out of range, allowed [0, 1]"),
+    (["-integrator", "ts", "-ts_max_snes_failures", "-5"],
+     "-ts_max_snes_failures -5: out of range, allowed an integer >= -1"),
 ]
 
 
@@ -165,6 +175,26 @@ def test_bad_values(case, previous_run, tmp_path):
     one_error(run(["-grid_n", "16,16", "-steps", "2"] + args + ["-output_dir", str(previous_run)],
                   cwd=tmp_path), needle)
     assert snapshot(previous_run) == before
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_restart_from_a_non_finite_checkpoint(ranks, tmp_path):
+    """A checkpoint holding a NaN is refused at the restart, not reported as a divergence later;
+    the directory is left as it was."""
+    out = tmp_path / "out"
+    r = run(SMALL + ["-steps", "4", "-output_dir", str(out)], cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    ck = out / "checkpoint_0000004.vtkhdf"
+    with h5py.File(ck, "r+") as h:
+        b = h["VTKHDF/PointData/b"]
+        v = np.array(b)
+        v.flat[37] = np.nan
+        b[...] = v
+    before = snapshot(out)
+    one_error(run(SMALL + ["-steps", "8", "-restart", "latest", "-output_dir", str(out)],
+                  cwd=tmp_path, ranks=ranks),
+              f"-restart {ck}: species b holds a non-finite value (nan)")
+    assert snapshot(out) == before
 
 
 def test_options_file_works(tmp_path):
