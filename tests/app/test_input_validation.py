@@ -152,6 +152,7 @@ BAD_VALUES = [
     (["-integrator", "ts", "-D_a", "1e20"], "allowed at most 1e+12 times"),
     (["-integrator", "ts", "-ts_diffusion", "explicit", "-force_dt", "-dt", "1e308", "-steps",
       "10"], "-dt 1e+308: the end time -steps 10 times -dt overflows a double"),
+    (["-restart", ""], '-restart "": needs a checkpoint file or \'latest\''),
     (["-dt", "1e-320"], "-dt 1e-320: out of range, allowed >= 2.22507e-308"),
     (["-dt", "0"], "-dt 0: out of range, allowed >= 2.22507e-308"),
     (["-layers", "16"], "-layers 16: 16 layers of turing's 2 species make 32, allowed at most 16 "
