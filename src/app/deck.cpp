@@ -299,9 +299,16 @@ std::string load_deck(int* argc, char*** argv, const std::vector<OptionsFileArg>
 }
 
 std::string read_deck_dir(Options& opt, const std::string& deck_dir) {
-  return opt.string("deck_dir", deck_dir,
-                    "directory where relative file names in values (png(...), strokes(...)) are "
-                    "looked up first, then the working directory (default: the deck's)");
+  const std::string dir =
+      opt.string("deck_dir", deck_dir,
+                 "directory where relative file names in values (png(...), strokes(...)) are "
+                 "looked up first, then the working directory (default: the deck's)");
+  // (a directory that does not exist here, as in options_used.yaml rerun on another machine,
+  // only drops the first place of the lookup; a file is a mistake)
+  std::error_code ec;
+  if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec))
+    throw UserError("-deck_dir " + shown(dir) + ": not a directory");
+  return dir;
 }
 
 } // namespace morphogen

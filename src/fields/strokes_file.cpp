@@ -2,12 +2,16 @@
 
 #include "core/user_error.hpp"
 
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
 namespace morphogen {
 
 std::string read_stroke_file_text(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) // (a directory, /dev/zero: never ending)
+    throw UserError("strokes file " + path + ": no such file (or not a regular file)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw UserError("strokes file " + path + ": cannot be read (missing file?)");
   std::ostringstream s;

@@ -1,4 +1,5 @@
 // JSON stroke files (format in strokes_file.hpp), read with nlohmann::json.
+#include "core/json_depth.hpp"
 #include "core/user_error.hpp"
 #include "fields/strokes_file.hpp"
 
@@ -17,18 +18,25 @@ std::string parse_reason(const std::string& what) {
   std::string r = what;
   if (const auto p = r.find(": "); p != std::string::npos && r.rfind("[json.", 0) == 0)
     r = r.substr(p + 2);
+  else if (const auto q = r.find("] "); q != std::string::npos && r.rfind("[json.", 0) == 0)
+    r = r.substr(q + 2); // "[json.exception.out_of_range.406] number overflow ..."
   for (char& c : r)
     if (c == '\n' || c == '\r') c = ' ';
   return r;
 }
 
 json parse_document(const std::string& path, const std::string& text) {
+  if (const int depth = json_nesting_depth(text); depth > kMaxJsonDepth)
+    throw UserError("strokes file " + path + ": nested " + std::to_string(depth) +
+                    " levels deep, allowed at most " + std::to_string(kMaxJsonDepth));
   try {
     return json::parse(text);
   } catch (const json::parse_error& e) {
     const std::size_t at = e.byte > 0 ? e.byte - 1 : 0; // e.byte: 1-based byte of the error
     throw UserError("strokes file " + path + ": " + line_column(text, at) + ": " +
                     parse_reason(e.what()));
+  } catch (const json::exception& e) { // e.g. a number that overflows a double (1e400)
+    throw UserError("strokes file " + path + ": " + parse_reason(e.what()));
   }
 }
 

@@ -1,6 +1,7 @@
 #include "fields/velocity_series.hpp"
 
 #include "core/collective_error.hpp"
+#include "core/json_depth.hpp"
 #include "core/user_error.hpp"
 #include "io/h5_arrays.hpp"
 
@@ -49,6 +50,9 @@ std::vector<VelocityFrame> series_frames(const std::string& opt_text, const std:
   if (!f) throw UserError(where + "no such file");
   std::stringstream ss;
   ss << f.rdbuf();
+  if (const int depth = json_nesting_depth(ss.str()); depth > kMaxJsonDepth)
+    throw UserError(where + "not a valid .series JSON file (nested " + std::to_string(depth) +
+                    " levels deep, allowed at most " + std::to_string(kMaxJsonDepth) + ")");
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(ss.str());

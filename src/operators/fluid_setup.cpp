@@ -5,6 +5,7 @@
 #include "fields/value_spec.hpp"
 
 #include <algorithm>
+#include <limits>
 
 namespace morphogen {
 
@@ -88,7 +89,7 @@ std::unique_ptr<FluidSolver> read_fluid(Options& opt, const Grid& grid, std::uin
     throw UserError(s.option_text + ": the fluid solver is 2-D only (the grid is " +
                     std::to_string(grid.dim()) + "-D; use a 2-D -grid_n nx,ny)");
   if (s.kind != fluid::Kind::Periodic) check_walls(grid, s.option_text);
-  s.viscosity = opt.real("fluid_viscosity", 0.01, 0.0, Options::inf,
+  s.viscosity = opt.real("fluid_viscosity", 0.01, 0.0, std::numeric_limits<double>::max(),
                          "kinematic viscosity nu of the fluid (implicit; 0: inviscid)");
   if (s.kind == fluid::Kind::Cavity)
     s.lid = opt.real("fluid_lid_speed", 1.0, -1e6, 1e6,

@@ -167,7 +167,8 @@ std::vector<std::string> screen_mismatches(const SweepSpec& spec, const Simulati
   const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
   std::vector<std::string> out;
   const std::string name = file.filename().string();
-  if (!in || j.is_discarded() || (j.value("table", "") != name && j.value("table_h5", "") != name))
+  if (!in || j.is_discarded() || !j.is_object() ||
+      (j.value("table", "") != name && j.value("table_h5", "") != name))
     return out;
   const ModelEntry& m = sim.model();
   if (j.value("model", "") != m.name)

@@ -198,6 +198,37 @@ def test_restart_from_a_non_finite_checkpoint(ranks, tmp_path):
     assert snapshot(out) == before
 
 
+def test_bad_files_in_values(previous_run, tmp_path):
+    """Strokes and .series files nested absurdly deep (a stack overflow before), a number that
+    overflows a double in a strokes file (an internal error before), a strokes "file" that is a
+    directory, a -deck_dir that is a file, an infinite viscosity: one line each."""
+    (tmp_path / "big.json").write_text(
+        '{"strokes": [{"points": [[0.2,0.3],[0.5,1e400]]}], "units": "fraction"}')
+    n = 100000
+    (tmp_path / "deep.json").write_text('{"strokes": [{"points": ' + "[" * n + "]" * n + "}]}")
+    (tmp_path / "deep.series").write_text('{"files": ' + "[" * n + "]" * n + "}")
+    (tmp_path / "dir.json").mkdir()
+    (tmp_path / "afile").write_text("x")
+    fluid = ["-model", "custom", "-species", "dye", "-rate_dye", "0", "-D_dye", "0", "-grid_L",
+             "1", "-grid_bc", "neumann", "-init_dye", "x<0.5", "-advect", "dye", "-dt", "0.01",
+             "-fluid", "cavity"]
+    cases = [
+        (["-init_a", '4 + strokes("big.json")'],
+         "strokes file big.json: number overflow parsing '1e400'"),
+        (["-init_a", '4 + strokes("deep.json")'],
+         "strokes file deep.json: nested 100003 levels deep, allowed at most 64"),
+        (["-advect", "a", "-grid_bc", "neumann", "-velocity_file", "deep.series"],
+         "-velocity_file deep.series: not a valid .series JSON file (nested 100001 levels deep"),
+        (["-init_a", '4 + strokes("dir.json")'], "strokes file dir.json: no such file"),
+        (["-deck_dir", "afile"], "-deck_dir afile: not a directory"),
+        (fluid + ["-fluid_viscosity", "inf"], "-fluid_viscosity inf: out of range, allowed >= 0"),
+    ]
+    before = snapshot(previous_run)
+    for args, needle in cases:
+        one_error(run(SMALL + args + ["-output_dir", str(previous_run)], cwd=tmp_path), needle)
+    assert snapshot(previous_run) == before
+
+
 def test_options_file_works(tmp_path):
     (tmp_path / "o.txt").write_text("# plain PETSc format\n-grid_n 16,16\n-steps 3\n")
     (tmp_path / "o.yaml").write_text("png_every: 0\n")
