@@ -8,7 +8,6 @@
 #include "app/run_loop.hpp"
 #include "app/simulation.hpp"
 #include "core/collective_error.hpp"
-#include "core/options.hpp"
 #include "core/user_error.hpp"
 
 #include <filesystem>
@@ -72,9 +71,6 @@ int run_main(int* argc, char*** argv, double wall_start,
       opt.string("restart", "",
                  "restart from a checkpoint file, or 'latest': the newest complete checkpoint in "
                  "-output_dir (none there: start from the initial condition)");
-  if (opt.is_set("restart") && restart.find_first_not_of(" \t") == std::string::npos)
-    throw UserError("-restart " + shown(restart) +
-                    ": needs a checkpoint file or 'latest' (leave -restart out to start afresh)");
   auto first = std::make_unique<Simulation>(comm, opt, base_dir, SequenceLevel{0, levels, nullptr});
   PngOutput pngs(opt, *first);
   if (opt.help_requested()) {

@@ -10,8 +10,8 @@ namespace morphogen {
 
 std::string read_stroke_file_text(const std::string& path) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) // (a directory, /dev/zero: never ending)
-    throw UserError("strokes file " + path + ": no such file (or not a regular file)");
+  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+    throw UserError("strokes file " + path + ": not a regular file (a directory or a device)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw UserError("strokes file " + path + ": cannot be read (missing file?)");
   std::ostringstream s;

@@ -152,7 +152,6 @@ BAD_VALUES = [
     (["-integrator", "ts", "-D_a", "1e20"], "allowed at most 1e+12 times"),
     (["-integrator", "ts", "-ts_diffusion", "explicit", "-force_dt", "-dt", "1e308", "-steps",
       "10"], "-dt 1e+308: the end time -steps 10 times -dt overflows a double"),
-    (["-restart", ""], '-restart "": needs a checkpoint file or \'latest\''),
     (["-dt", "1e-320"], "-dt 1e-320: out of range, allowed >= 2.22507e-308"),
     (["-dt", "0"], "-dt 0: out of range, allowed >= 2.22507e-308"),
     (["-layers", "16"], "-layers 16: 16 layers of turing's 2 species make 32, allowed at most 16 "
@@ -219,7 +218,7 @@ def test_bad_files_in_values(previous_run, tmp_path):
          "strokes file deep.json: nested 100003 levels deep, allowed at most 64"),
         (["-advect", "a", "-grid_bc", "neumann", "-velocity_file", "deep.series"],
          "-velocity_file deep.series: not a valid .series JSON file (nested 100001 levels deep"),
-        (["-init_a", '4 + strokes("dir.json")'], "strokes file dir.json: no such file"),
+        (["-init_a", '4 + strokes("dir.json")'], "strokes file dir.json: not a regular file"),
         (["-deck_dir", "afile"], "-deck_dir afile: not a directory"),
         (fluid + ["-fluid_viscosity", "inf"], "-fluid_viscosity inf: out of range, allowed >= 0"),
     ]
