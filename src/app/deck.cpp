@@ -7,7 +7,6 @@
 #include "core/user_error.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -62,10 +61,8 @@ std::string check_map(const YAML::Node& map, const std::string& prefix, const st
       if (const std::string e = check_map(value, option, name, seen); !e.empty()) return e;
       continue;
     }
-    std::string folded = option; // PETSc's option names ignore case: D_a and d_a are one
-    for (char& c : folded)
-      c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    const auto [prev, fresh] = seen.emplace(folded, key.Mark());
+    // (PETSc's option names ignore case: D_a and d_a are one)
+    const auto [prev, fresh] = seen.emplace(lower_case(option), key.Mark());
     if (!fresh)
       return at(name, key.Mark()) + ": duplicate key " + key.Scalar() + " (option -" + option +
              ", already given at line " + std::to_string(prev->second.line + 1) + ")";

@@ -80,6 +80,12 @@ std::vector<std::pair<std::string, std::string>> all_petsc_options() {
   return all;
 }
 
+std::string lower_case(std::string text) {
+  for (char& c : text)
+    c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return text;
+}
+
 std::string shown(const std::string& value) {
   bool plain = !value.empty();
   for (unsigned char c : value)
@@ -225,8 +231,7 @@ bool Options::flag(const std::string& name, bool def, const std::string& help) {
   auto s = get(name, h);
   bool v = def;
   if (s) {
-    std::string t = *s;
-    std::transform(t.begin(), t.end(), t.begin(), ::tolower);
+    const std::string t = lower_case(*s);
     if (t.empty() || t == "true" || t == "1" || t == "yes" || t == "on")
       v = true;
     else if (t == "false" || t == "0" || t == "no" || t == "off")

@@ -114,6 +114,9 @@ std::string name_petsc_option_error(const std::string& prefix, const std::string
 // PETSc message made fit for a one-line error.
 std::string one_line(const std::string& text);
 
+// text in lower case (ASCII), as PETSc compares option names and flag values.
+std::string lower_case(std::string text);
+
 // A value as a message shows it: as is, or in double quotes when it is empty or has white
 // space or control characters at all (-steps " ", -integrator "ts "), which would not show.
 std::string shown(const std::string& value);

@@ -1,5 +1,6 @@
 #include "fields/strokes_file.hpp"
 
+#include "core/options.hpp"
 #include "core/user_error.hpp"
 
 #include <filesystem>
@@ -46,10 +47,7 @@ namespace {
 std::string extension(const std::string& path) {
   const auto slash = path.find_last_of('/'), dot = path.find_last_of('.');
   if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
-  std::string e = path.substr(dot + 1);
-  for (char& c : e)
-    c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return e;
+  return lower_case(path.substr(dot + 1));
 }
 
 } // namespace

@@ -1,4 +1,5 @@
 // User-defined kinetics from muParser expressions (see models/runtime_model.hpp).
+#include "core/options.hpp"
 #include "core/user_error.hpp"
 #include "fields/column_program.hpp"
 #include "fields/value_spec.hpp"
@@ -8,7 +9,6 @@
 #include <muParser.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <limits>
 #include <set>
@@ -183,10 +183,7 @@ void check_species(const CustomKinetics& spec) {
       throw UserError("-species " + n +
                       ": not a usable species name (letters, digits and _, starting with a "
                       "letter; not x, y, z, t or pi)");
-    std::string folded = n;
-    for (char& c : folded)
-      c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (!seen.insert(folded).second)
+    if (!seen.insert(lower_case(n)).second)
       throw UserError("-species " + n +
                       ": given twice (species names are compared ignoring "
                       "case, as option names like -D_" +
